@@ -1,0 +1,162 @@
+// math/gauss_legendre.h - Gauss-Legendre quadrature (paper section 6, "Adaptive Quadrature"):
+// nodes and weights for any n, the fixed tensor-product 2D rule, and the adaptive 1D and 2D
+// rules that compare n against n + 1 points, split the interval (cell) in two (four), and share
+// the tolerance among the children. Every adaptive rule counts its integrand evaluations.
+#pragma once
+
+#include <cmath>
+#include <utility>
+#include <vector>
+
+#include "math/check.h"
+#include "math/vec3.h"
+
+namespace mbr {
+
+/// The n-point Gauss-Legendre rule on [-1, 1]: nodes ascending, weights summing to 2.
+/// Nodes and weights are accurate to about 1e-15 (Newton's method on P_n, with the
+/// three-term recurrence), for any n >= 1.
+struct GaussLegendre {
+    std::vector<double> x;  // nodes in (-1, 1)
+    std::vector<double> w;  // weights
+    int n() const { return static_cast<int>(x.size()); }
+};
+GaussLegendre gauss_legendre(int n);
+
+/// sum_i w_i f(x_i) mapped to [a, b].
+template <class F>
+auto integrate_1d(F&& f, double a, double b, const GaussLegendre& rule) {
+    const double half = 0.5 * (b - a), mid = 0.5 * (a + b);
+    decltype(f(a)) sum{};
+    for (int i = 0; i < rule.n(); ++i) sum += rule.w[i] * f(mid + half * rule.x[i]);
+    return sum * half;
+}
+
+/// The fixed 2D rule of section 6: sum_i sum_j w_i w_j f(x_i, x_j), mapped to a rectangle
+/// (the factor is the Jacobian of the map from [-1,1]^2).
+template <class F>
+auto integrate_2d(F&& f, const Rect& r, const GaussLegendre& rule) {
+    const double hx = 0.5 * r.width(), hy = 0.5 * r.height();
+    const double cx = 0.5 * (r.x0 + r.x1), cy = 0.5 * (r.y0 + r.y1);
+    decltype(f(cx, cy)) sum{};
+    for (int i = 0; i < rule.n(); ++i) {
+        decltype(f(cx, cy)) row{};
+        for (int j = 0; j < rule.n(); ++j) row += rule.w[j] * f(cx + hx * rule.x[i], cy + hy * rule.x[j]);
+        sum += rule.w[i] * row;
+    }
+    return sum * (hx * hy);
+}
+
+/// Options of the adaptive rules (section 6).
+struct AdaptiveOptions {
+    int n = 4;               // compare the n-point rule with the (n+1)-point rule
+    double tolerance = 1e-8; // absolute error allowed on the whole domain
+    int max_depth = 12;      // no cell is split more than this many times
+};
+
+/// A dyadic cell of the adaptive 2D rule: level, index (i, j) within the domain, its rectangle.
+struct QuadCell {
+    int level = 0, i = 0, j = 0;
+    Rect rect;
+};
+
+/// One accepted cell of an adaptive 2D integration and the integral found on it.
+template <class V>
+struct AcceptedCell {
+    QuadCell cell;
+    V value{};
+};
+
+template <class V>
+struct AdaptiveResult {
+    V value{};                 // the integral (the n+1 rule, summed over accepted cells)
+    long n_evaluations = 0;    // integrand evaluations, both rules, all cells
+    int depth = 0;             // deepest level reached
+    bool converged = true;     // false when some cell hit max_depth before agreeing
+    std::vector<AcceptedCell<V>> cells;  // the partition, when asked for
+};
+
+/// Adaptive 1D rule: on [a, b] apply the n- and (n+1)-point rules; if they differ by less than
+/// the tolerance keep the (n+1)-point value, otherwise halve the interval and give each half
+/// half the tolerance, so the accumulated error stays within the tolerance.
+template <class F>
+auto adaptive_integrate_1d(F&& f, double a, double b, const AdaptiveOptions& opt) {
+    using V = decltype(f(a));
+    const GaussLegendre rule_n = gauss_legendre(opt.n), rule_n1 = gauss_legendre(opt.n + 1);
+    AdaptiveResult<V> result;
+    struct Work { double a, b, tol; int depth; };
+    std::vector<Work> stack{{a, b, opt.tolerance, 0}};
+    while (!stack.empty()) {
+        Work w = stack.back();
+        stack.pop_back();
+        V f0 = integrate_1d(f, w.a, w.b, rule_n);
+        V f1 = integrate_1d(f, w.a, w.b, rule_n1);
+        result.n_evaluations += 2 * opt.n + 1;
+        if (w.depth > result.depth) result.depth = w.depth;
+        bool agree = max_abs(f1 - f0) < w.tol;
+        if (agree || w.depth >= opt.max_depth) {
+            if (!agree) result.converged = false;
+            result.value += f1;
+            continue;
+        }
+        double mid = 0.5 * (w.a + w.b);
+        stack.push_back({mid, w.b, 0.5 * w.tol, w.depth + 1});
+        stack.push_back({w.a, mid, 0.5 * w.tol, w.depth + 1});
+    }
+    return result;
+}
+
+/// Adaptive 2D rule over dyadic cells of `domain`, with the cell rule supplied by the caller:
+/// cell_rule(cell, n) returns the n x n tensor Gauss-Legendre value on cell.rect. (The
+/// radiosity kernel uses this form to cache the shooter's points per cell.) Splits a cell into
+/// four children with a quarter of its tolerance each. Evaluations are counted as n^2 + (n+1)^2
+/// per visited cell.
+template <class CellRule>
+auto adaptive_tensor_rule_2d(CellRule&& cell_rule, const Rect& domain, const AdaptiveOptions& opt,
+                             bool keep_cells = false) {
+    using V = decltype(cell_rule(QuadCell{}, 1));
+    AdaptiveResult<V> result;
+    struct Work { QuadCell cell; double tol; };
+    std::vector<Work> stack{{QuadCell{0, 0, 0, domain}, opt.tolerance}};
+    const long evals_per_cell = long(opt.n) * opt.n + long(opt.n + 1) * (opt.n + 1);
+    while (!stack.empty()) {
+        Work w = stack.back();
+        stack.pop_back();
+        V f0 = cell_rule(w.cell, opt.n);
+        V f1 = cell_rule(w.cell, opt.n + 1);
+        result.n_evaluations += evals_per_cell;
+        if (w.cell.level > result.depth) result.depth = w.cell.level;
+        bool agree = max_abs(f1 - f0) < w.tol;
+        if (agree || w.cell.level >= opt.max_depth) {
+            if (!agree) result.converged = false;
+            result.value += f1;
+            if (keep_cells) result.cells.push_back({w.cell, f1});
+            continue;
+        }
+        const Rect& r = w.cell.rect;
+        const double xm = 0.5 * (r.x0 + r.x1), ym = 0.5 * (r.y0 + r.y1);
+        // Children pushed in reverse so they are visited in (0,0), (1,0), (0,1), (1,1) order.
+        for (int c = 3; c >= 0; --c) {
+            int di = c & 1, dj = c >> 1;
+            QuadCell child{w.cell.level + 1, 2 * w.cell.i + di, 2 * w.cell.j + dj,
+                           Rect{di ? xm : r.x0, di ? r.x1 : xm, dj ? ym : r.y0, dj ? r.y1 : ym}};
+            stack.push_back({child, 0.25 * w.tol});
+        }
+    }
+    return result;
+}
+
+/// Adaptive 2D rule of section 6 for a plain integrand f(x, y).
+template <class F>
+auto adaptive_integrate_2d(F&& f, const Rect& domain, const AdaptiveOptions& opt,
+                           bool keep_cells = false) {
+    std::vector<GaussLegendre> rules;  // rules[n] built on first use
+    auto cell_rule = [&](const QuadCell& cell, int n) {
+        if (static_cast<int>(rules.size()) <= n) rules.resize(n + 1);
+        if (rules[n].n() != n) rules[n] = gauss_legendre(n);
+        return integrate_2d(f, cell.rect, rules[n]);
+    };
+    return adaptive_tensor_rule_2d(cell_rule, domain, opt, keep_cells);
+}
+
+}  // namespace mbr
