@@ -153,7 +153,8 @@ DualTable::DualTable(int m, double tail_eps) : m_(m) {
             if (std::abs(l) > L) continue;
             for (int c = 0; c < m; ++c) coef_[size_t(i - first_) * m + c] += mu_[std::abs(l)] * piece[o][c];
         }
-    max_abs_ = max_abs_on(fulcrum() - 1, fulcrum() + 1);
+    // |DN_m| is largest at its fulcrum (its central lobe; the others decay geometrically).
+    max_abs_ = std::fabs((*this)(fulcrum()));
 
     // Monotone envelope on a 1/16 grid of distances from the fulcrum.
     const int n_env = static_cast<int>(std::ceil(half_width() * 16)) + 1;
@@ -185,7 +186,7 @@ double DualTable::max_abs_on(double a, double b) const {
         // max |p'| on [0, 1] is at most sum_k k |c_k|: bounds the sampling error.
         double dbound = 0;
         for (int k = 1; k < m_; ++k) dbound += k * std::fabs(c[k]);
-        const int samples = 16;
+        const int samples = 64;
         double h = (hi - lo) / samples;
         for (int s = 0; s <= samples; ++s) {
             double t = lo + s * h, v = c[m_ - 1];

@@ -53,7 +53,7 @@ public:
     const std::vector<double>& mu() const { return mu_; }
     /// Half-width of the tabulated support, measured from the fulcrum.
     double half_width() const { return last_ - fulcrum() + 1; }
-    /// Largest |DN_m|, attained at the fulcrum.
+    /// Largest |DN_m|, attained at the fulcrum: DN_m(m/2).
     double max_abs() const { return max_abs_; }
     /// Bound on |DN_m(x) - table(x)| for all x: the largest dropped |mu_l| plus the solve's
     /// convergence tolerance (the N_m(x - l) at any x sum to one).

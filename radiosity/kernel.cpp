@@ -1,0 +1,128 @@
+// radiosity/kernel.cpp - the analytic reference form factor and the adaptive quadrature of (21).
+#include "radiosity/kernel.h"
+
+#include <cmath>
+
+#include "math/check.h"
+
+namespace mbr {
+
+double point_polygon_form_factor(Vec3 p, Vec3 n_p, const std::vector<Vec3>& polygon) {
+    if (polygon.size() < 3) return 0;
+    // One-sided: the polygon's front (Newell normal of its counter-clockwise order) must face p.
+    Vec3 normal{};
+    for (size_t i = 0; i < polygon.size(); ++i) {
+        const Vec3& a = polygon[i];
+        const Vec3& b = polygon[(i + 1) % polygon.size()];
+        normal += cross(a, b);
+    }
+    Vec3 centroid{};
+    for (const Vec3& v : polygon) centroid += v;
+    centroid = centroid / double(polygon.size());
+    if (dot(p - centroid, normal) <= 0) return 0;
+
+    // Clip against p's tangent plane: keep the part with (v - p) . n_p >= 0.
+    std::vector<Vec3> clipped;
+    clipped.reserve(polygon.size() + 2);
+    for (size_t i = 0; i < polygon.size(); ++i) {
+        const Vec3& a = polygon[i];
+        const Vec3& b = polygon[(i + 1) % polygon.size()];
+        const double da = dot(a - p, n_p), db = dot(b - p, n_p);
+        if (da >= 0) clipped.push_back(a);
+        if ((da >= 0) != (db >= 0)) clipped.push_back(a + (da / (da - db)) * (b - a));
+    }
+    if (clipped.size() < 3) return 0;
+
+    // Lambert: F = (1 / 2 pi) sum_i gamma_i n_p . (R_i x R_{i+1}) / |R_i x R_{i+1}|.
+    double sum = 0;
+    for (size_t i = 0; i < clipped.size(); ++i) {
+        const Vec3 r_i = clipped[i] - p;
+        const Vec3 r_next = clipped[(i + 1) % clipped.size()] - p;
+        const Vec3 c = cross(r_i, r_next);
+        const double c_len = length(c);
+        if (c_len <= 0) continue;  // collinear with p: the edge contributes nothing
+        const double gamma = std::atan2(c_len, dot(r_i, r_next));  // angle between R_i, R_i+1
+        sum += gamma * dot(n_p, c) / c_len;
+    }
+    return std::fabs(sum) / (2 * Pi);
+}
+
+IncrementIntegrator::IncrementIntegrator(const Shooter& shooter, const QuadratureOptions& options)
+    : shooter_(shooter), options_(options) {
+    MBR_CHECK(shooter.surface != nullptr && !shooter.unshot.empty());
+    MBR_CHECK(options.n >= 1 && options.max_depth >= 0 && options.max_depth <= 28);
+    unshot_bound_ = shooter.unshot.max_abs_coefficient();  // B-splines sum to one
+    rules_.resize(options.n + 2);
+    for (int n = 1; n <= options.n + 1; ++n) rules_[n] = gauss_legendre(n);
+}
+
+const std::vector<ShooterPoint>& IncrementIntegrator::points(const QuadCell& cell, int n) {
+    // Key: level (5 bits), i and j (28 bits each: cells of [0,1]^2 have non-negative indices
+    // below 2^level), and which of the two rules.
+    const std::uint64_t key = (std::uint64_t(cell.level) << 57) | (std::uint64_t(cell.i) << 29) |
+                              (std::uint64_t(cell.j) << 1) | std::uint64_t(n == options_.n ? 0 : 1);
+    auto it = cache_.find(key);
+    if (it != cache_.end()) return it->second;
+    // Bound the cache (deep singular corners can make many cells); values never depend on it.
+    if (cached_points_ > 4000000) {
+        cache_.clear();
+        cached_points_ = 0;
+    }
+    const GaussLegendre& rule = rules_[n];
+    const Rect& r = cell.rect;
+    const double hx = 0.5 * r.width(), hy = 0.5 * r.height();
+    std::vector<ShooterPoint> pts;
+    pts.reserve(size_t(n) * n);
+    for (int a = 0; a < n; ++a)
+        for (int b = 0; b < n; ++b) {
+            const double u = r.x0 + hx * (rule.x[a] + 1), v = r.y0 + hy * (rule.x[b] + 1);
+            const SurfacePoint sp = shooter_.surface->evaluate(u, v);
+            const double w_J_A = rule.w[a] * rule.w[b] * hx * hy * sp.area_factor;
+            pts.push_back({sp.position, sp.normal, w_J_A * shooter_.unshot.evaluate(u, v)});
+        }
+    cached_points_ += pts.size();
+    return cache_.emplace(key, std::move(pts)).first->second;
+}
+
+Rgb IncrementIntegrator::sum_over(const SurfacePoint& p, const std::vector<ShooterPoint>& pts) const {
+    Rgb sum;
+    for (const ShooterPoint& q : pts) {
+        const double F = form_factor_kernel(p.position, p.normal, q.x, q.n);  // eq. (3)
+        if (F != 0) sum += F * q.e;
+    }
+    return sum;
+}
+
+IncrementIntegrator::Result IncrementIntegrator::integrate(const SurfacePoint& p,
+                                                           bool keep_partition) {
+    // The tolerance is relative to the (n+1)-point estimate over the whole shooter, with a
+    // floor at 1e-4 of the largest possible value (F integrates to at most 1 over the shooter,
+    // so I(p) <= max B_h): a point that sees almost nothing does not ask for endless splitting.
+    const QuadCell root{0, 0, 0, Rect{0, 1, 0, 1}};
+    const double estimate = max_abs(sum_over(p, points(root, options_.n + 1)));
+    const double scale = std::max(estimate, 1e-4 * unshot_bound_);
+    Result result;
+    AdaptiveOptions opt;
+    opt.n = options_.n;
+    opt.tolerance = options_.rel_tolerance * scale;
+    opt.max_depth = options_.max_depth;
+    opt.min_share = options_.min_share;
+    auto cell_rule = [&](const QuadCell& cell, int n) { return sum_over(p, points(cell, n)); };
+    auto r = adaptive_tensor_rule_2d(cell_rule, root.rect, opt, keep_partition);
+    result.value = r.value;
+    result.n_evaluations = r.n_evaluations + long(options_.n + 1) * (options_.n + 1);
+    result.converged = r.converged;
+    result.partition = std::move(r.cells);
+    return result;
+}
+
+Rgb IncrementIntegrator::integrate_on(const SurfacePoint& p,
+                                      const std::vector<AcceptedCell<Rgb>>& partition,
+                                      long* n_evaluations) {
+    Rgb sum;
+    for (const auto& c : partition) sum += sum_over(p, points(c.cell, options_.n + 1));
+    if (n_evaluations) *n_evaluations += long(partition.size()) * (options_.n + 1) * (options_.n + 1);
+    return sum;
+}
+
+}  // namespace mbr

@@ -1,0 +1,95 @@
+// radiosity/kernel.h - the kernel of the radiosity equation and the sample value of one energy
+// transfer (paper section 2, eqs. (2)-(4); section 4, eq. (21); section 6, "Adaptive
+// Quadrature"), and the analytic point-to-polygon form factor used as the exact reference
+// (section 7: "an analytic formula advocated in [7]", Baum, Rushmeier and Winget 1989).
+#pragma once
+
+#include <cstdint>
+#include <unordered_map>
+#include <vector>
+
+#include "math/gauss_legendre.h"
+#include "radiosity/spline_field.h"
+#include "radiosity/surface.h"
+
+namespace mbr {
+
+/// F(p, x) of eq. (3) for a receiving point p (normal n_p) and a shooting point x (normal n_x):
+/// [l . n_p][-l . n_x] / (pi |l|^4) with l = x - p, each cosine clamped at zero, so that a point
+/// behind either surface receives nothing (surfaces are one-sided).
+inline double form_factor_kernel(Vec3 p, Vec3 n_p, Vec3 x, Vec3 n_x) {
+    const Vec3 l = x - p;
+    const double cos_p = dot(l, n_p);   // |l| cos(theta_p)
+    const double cos_x = -dot(l, n_x);  // |l| cos(theta_x)
+    if (cos_p <= 0 || cos_x <= 0) return 0;
+    const double l2 = dot(l, l);
+    return cos_p * cos_x / (Pi * l2 * l2);
+}
+
+/// The form factor from a differential area at p (unit normal n_p) to a planar polygon, by
+/// Lambert's contour integral: F = |sum_i angle(R_i, R_{i+1}) n_p . unit(R_i x R_{i+1})| / (2 pi)
+/// with R_i = v_i - p. The polygon is one-sided like the surfaces: its front (counter-clockwise
+/// side) must face p, else F = 0. Parts behind p's tangent plane are clipped away first.
+double point_polygon_form_factor(Vec3 p, Vec3 n_p, const std::vector<Vec3>& polygon);
+
+/// The shooting surface of one transfer and its unshot radiosity (already at the level the
+/// caller wants; section 6 coarsens it first).
+struct Shooter {
+    const Surface* surface = nullptr;
+    SplineField unshot;
+};
+
+/// Options of the adaptive quadrature of (21) over the shooter (section 6).
+struct QuadratureOptions {
+    int n = 4;                    // compare n x n with (n+1) x (n+1) Gauss-Legendre points
+    double rel_tolerance = 1e-6;  // allowed error relative to a first estimate of the integral
+    int max_depth = 24;           // cap on the shooter's subdivision (at most 28)
+    double min_share = 1e-6;      // floor of a cell's share of the tolerance (math/gauss_legendre.h)
+};
+
+/// One shooter point of the quadrature with everything that does not depend on the receiver:
+/// position, normal and e = w_a w_b J A_h(u,v) B_h(u,v) (Gauss-Legendre weights, the Jacobian
+/// J of the map from [-1,1]^2 to the cell, the area factor (4), the unshot radiosity).
+struct ShooterPoint {
+    Vec3 x;
+    Vec3 n;
+    Rgb e;
+};
+
+/// The integral of eq. (21) without the receiver's reflectance:
+///   I(p) = int_{[0,1]^2} F(p, x_h(u,v)) VIS B_h(u,v) A_h(u,v) du dv   (VIS = 1 here),
+/// by the adaptive rule of section 6 (n against n + 1 points per cell, split in four with a
+/// quarter of the tolerance). Shooter points are cached per dyadic cell, so one integrator per
+/// thread: the cache changes speed, never values, so results do not depend on thread count.
+class IncrementIntegrator {
+public:
+    IncrementIntegrator(const Shooter& shooter, const QuadratureOptions& options);
+
+    struct Result {
+        Rgb value;
+        long n_evaluations = 0;   // kernel evaluations
+        bool converged = true;
+        std::vector<AcceptedCell<Rgb>> partition;  // the shooter's cells, when asked for
+    };
+    /// I(p) by the adaptive rule; the shooter partition is kept when keep_partition is set
+    /// (the shadow stage casts rays to its cells; edgefill reuses it for divided differences).
+    Result integrate(const SurfacePoint& p, bool keep_partition = false);
+    /// I(p) on a given partition with the (n+1)-point rule on each cell: the same quadrature
+    /// error pattern as the run that made the partition, so divided differences (22) of nearby
+    /// points are not swamped by it.
+    Rgb integrate_on(const SurfacePoint& p, const std::vector<AcceptedCell<Rgb>>& partition,
+                     long* n_evaluations);
+    /// The points of a cell for the n-point rule (cached).
+    const std::vector<ShooterPoint>& points(const QuadCell& cell, int n);
+
+private:
+    Rgb sum_over(const SurfacePoint& p, const std::vector<ShooterPoint>& pts) const;
+    const Shooter& shooter_;
+    QuadratureOptions options_;
+    std::vector<GaussLegendre> rules_;  // rules_[n]
+    std::unordered_map<std::uint64_t, std::vector<ShooterPoint>> cache_;
+    size_t cached_points_ = 0;
+    double unshot_bound_ = 0;  // max |B_h| bound: the largest coefficient
+};
+
+}  // namespace mbr

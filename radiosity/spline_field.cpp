@@ -1,0 +1,136 @@
+// radiosity/spline_field.cpp - storage, evaluation (20), refinement (17), coarsening (11),
+// superposition and integration of a surface's radiosity coefficients.
+#include "radiosity/spline_field.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "math/check.h"
+#include "math/gauss_legendre.h"
+#include "math/wavelet.h"
+
+namespace mbr {
+
+SplineField::SplineField(int m, int level) : m_(m), level_(level) {
+    MBR_CHECK_MSG(m >= 2 && m <= 16 && level >= 0 && level <= 20, "m = " << m << ", j = " << level);
+    for (auto& g : grid_) g = touching_grid(m, level);
+}
+
+SplineField SplineField::constant(int m, int level, Rgb value) {
+    SplineField f(m, level);
+    for (int c = 0; c < 3; ++c) std::fill(f.grid_[c].a.begin(), f.grid_[c].a.end(), value[c]);
+    return f;
+}
+
+Rgb SplineField::coefficient(int k, int l) const {
+    return {grid_[0](k, l), grid_[1](k, l), grid_[2](k, l)};
+}
+
+void SplineField::set_coefficient(int k, int l, Rgb value) {
+    for (int c = 0; c < 3; ++c) grid_[c](k, l) = value[c];
+}
+
+Rgb SplineField::evaluate(double s, double t) const {
+    // Eq. (20) with the m x m basis functions that are non-zero at (s, t).
+    double bs[16], bt[16];
+    const int fk = bspline_values(m_, std::ldexp(s, level_), bs);
+    const int fl = bspline_values(m_, std::ldexp(t, level_), bt);
+    const CoefficientGrid& g0 = grid_[0];
+    Rgb sum;
+    for (int i = 0; i < m_; ++i) {
+        const int k = fk + i;
+        if (k < g0.first_k || k >= g0.first_k + g0.n_k || bs[i] == 0) continue;
+        Rgb row;
+        for (int j = 0; j < m_; ++j) {
+            const int l = fl + j;
+            if (l < g0.first_l || l >= g0.first_l + g0.n_l) continue;
+            row += bt[j] * coefficient(k, l);
+        }
+        sum += bs[i] * row;
+    }
+    return sum;
+}
+
+SplineField SplineField::refined_to(int level) const {
+    MBR_CHECK(level >= level_);
+    SplineField f = *this;
+    while (f.level_ < level) {
+        for (auto& g : f.grid_) g = refine_touching(m_, g);  // eq. (17)
+        ++f.level_;
+    }
+    return f;
+}
+
+SplineField SplineField::coarsened_to(int level) const {
+    MBR_CHECK(level >= 0 && level <= level_);
+    SplineField f = *this;
+    while (f.level_ > level) {
+        for (auto& g : f.grid_) g = coarsen(m_, g);  // orthogonal projection, eq. (11)
+        --f.level_;
+    }
+    return f;
+}
+
+void SplineField::add(const SplineField& other) {
+    if (other.empty()) return;
+    if (empty()) {
+        *this = other;
+        return;
+    }
+    MBR_CHECK_MSG(other.m_ == m_, "orders differ: " << m_ << " and " << other.m_);
+    if (other.level_ > level_) *this = refined_to(other.level_);
+    const SplineField& o = other.level_ < level_ ? other.refined_to(level_) : other;
+    for (int c = 0; c < 3; ++c)
+        for (size_t i = 0; i < grid_[c].a.size(); ++i) grid_[c].a[i] += o.grid_[c].a[i];
+}
+
+void SplineField::scale(double s) {
+    for (auto& g : grid_)
+        for (double& v : g.a) v *= s;
+}
+
+Rgb SplineField::integrate() const {
+    // int_0^1 N_m(2^j s - k) ds for every touching k, by m-point Gauss-Legendre per level-j cell
+    // (exact: the integrand is a polynomial of degree m - 1 on each cell).
+    const GaussLegendre rule = gauss_legendre(m_);
+    const int first = first_touching_index(m_), n = touching_count(m_, level_);
+    const int cells = 1 << level_;
+    std::vector<double> I(n, 0.0);
+    double b[16];
+    for (int cell = 0; cell < cells; ++cell)
+        for (int q = 0; q < m_; ++q) {
+            const double s = (cell + 0.5 * (rule.x[q] + 1)) / cells;
+            const int fk = bspline_values(m_, std::ldexp(s, level_), b);
+            for (int i = 0; i < m_; ++i) {
+                const int idx = fk + i - first;
+                if (idx >= 0 && idx < n) I[idx] += rule.w[q] * 0.5 / cells * b[i];
+            }
+        }
+    Rgb sum;
+    for (int k = 0; k < n; ++k)
+        for (int l = 0; l < n; ++l) sum += (I[k] * I[l]) * coefficient(first + k, first + l);
+    return sum;
+}
+
+Rgb SplineField::integrate_weighted(const std::function<double(double, double)>& w, int n) const {
+    const GaussLegendre rule = gauss_legendre(n);
+    const int cells = 1 << level_;
+    Rgb sum;
+    for (int ci = 0; ci < cells; ++ci)
+        for (int cj = 0; cj < cells; ++cj) {
+            Rect r{double(ci) / cells, double(ci + 1) / cells, double(cj) / cells,
+                   double(cj + 1) / cells};
+            sum += integrate_2d([&](double s, double t) { return w(s, t) * evaluate(s, t); }, r,
+                                rule);
+        }
+    return sum;
+}
+
+double SplineField::max_abs_coefficient() const {
+    double best = 0;
+    for (const auto& g : grid_)
+        for (double v : g.a) best = std::max(best, std::fabs(v));
+    return best;
+}
+
+}  // namespace mbr
