@@ -12,9 +12,9 @@ namespace mbr {
 namespace {
 
 // Relative tolerances of the constructor's checks (in units of the diameter, or radians).
-constexpr double planarity_tol = 1e-6;   // vertex distance from the plane / diameter
-constexpr double convexity_tol = 1e-7;   // largest allowed right turn (radians)
-constexpr double degeneracy_tol = 1e-12; // shortest edge / diameter; area / diameter^2
+constexpr double planarity_tol = 1e-6;    // vertex distance from the plane / diameter
+constexpr double convexity_tol = 1e-7;    // largest allowed right turn (radians)
+constexpr double degeneracy_tol = 1e-12;  // shortest edge / diameter; area / diameter^2
 // DESIGN: the closed inside test's slack, relative to the diameter (see polygon.h).
 constexpr double edge_slack_rel = 1e-10;
 
@@ -35,8 +35,8 @@ Polygon::Polygon(std::vector<Vec3> vertices, std::vector<Vec2> uv, int surface)
     : vertices_(std::move(vertices)), uv_(std::move(uv)), surface_(surface) {
     const int n = n_vertices();
     MBR_CHECK_MSG(n >= 3, "a polygon needs at least 3 vertices, got " << n);
-    MBR_CHECK_MSG(uv_.size() == vertices_.size(),
-                  uv_.size() << " (u,v) pairs for " << n << " vertices");
+    MBR_CHECK_MSG(uv_.size() == vertices_.size(), uv_.size()
+                                                      << " (u,v) pairs for " << n << " vertices");
     for (Vec3 v : vertices_) MBR_CHECK_MSG(is_finite(v), "vertex " << v);
     for (Vec3 v : vertices_) bounds_.extend(v);
     for (int i = 0; i < n; ++i)
@@ -50,8 +50,7 @@ Polygon::Polygon(std::vector<Vec3> vertices, std::vector<Vec2> uv, int surface)
     for (int i = 1; i + 1 < n; ++i)
         area_vector += cross(vertices_[i] - vertices_[0], vertices_[i + 1] - vertices_[0]);
     area_ = 0.5 * length(area_vector);
-    MBR_CHECK_MSG(area_ > degeneracy_tol * diameter_ * diameter_,
-                  "zero-area polygon " << *this);
+    MBR_CHECK_MSG(area_ > degeneracy_tol * diameter_ * diameter_, "zero-area polygon " << *this);
     Vec3 n_p = normalize(area_vector);
     Vec3 centroid;
     for (Vec3 v : vertices_) centroid += v;
@@ -73,9 +72,9 @@ Polygon::Polygon(std::vector<Vec3> vertices, std::vector<Vec2> uv, int surface)
         MBR_CHECK_MSG(length(b) > degeneracy_tol * diameter_,
                       "zero-length edge at vertex " << i << " of " << *this);
         double turn = std::atan2(dot(n_p, cross(a, b)), dot(a, b));
-        MBR_CHECK_MSG(turn >= -convexity_tol && turn < Pi - convexity_tol,
-                      "non-convex polygon " << *this << ": turn of " << turn
-                                            << " rad at vertex " << i);
+        MBR_CHECK_MSG(
+            turn >= -convexity_tol && turn < Pi - convexity_tol,
+            "non-convex polygon " << *this << ": turn of " << turn << " rad at vertex " << i);
         total_turn += turn;
     }
     MBR_CHECK_MSG(std::fabs(total_turn - 2 * Pi) < 1e-6,

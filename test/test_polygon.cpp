@@ -2,7 +2,6 @@
 // (paper section 6, "Octree", Figure 6), the bounding-plane ray-polygon test against an
 // independent in-plane reference, and the (u, v) interpolation of hit points.
 #include <catch2/catch.hpp>
-
 #include <cmath>
 #include <random>
 #include <vector>
@@ -76,7 +75,9 @@ Vec3 bilerp(const std::vector<Vec3>& c, double s, double t) {
     return (1 - s) * (1 - t) * c[0] + s * (1 - t) * c[1] + s * t * c[2] + (1 - s) * t * c[3];
 }
 
-std::vector<Vec2> no_uv(int n) { return std::vector<Vec2>(n); }
+std::vector<Vec2> no_uv(int n) {
+    return std::vector<Vec2>(n);
+}
 
 }  // namespace
 
@@ -122,7 +123,7 @@ TEST_CASE("polygon: bounding planes contain their edge and the normal and point 
             const Plane& b = p.bounding_planes()[i];
             Vec3 edge = p.vertices()[(i + 1) % n] - p.vertices()[i];
             CHECK(std::fabs(length(b.normal) - 1) < 1e-14);
-            CHECK(std::fabs(dot(b.normal, p.normal())) < 1e-9);  // contains the normal
+            CHECK(std::fabs(dot(b.normal, p.normal())) < 1e-9);           // contains the normal
             CHECK(std::fabs(dot(b.normal, edge)) < 1e-9 * length(edge));  // contains the edge
             CHECK(std::fabs(b.signed_distance(p.vertices()[i])) < tol);
             CHECK(std::fabs(b.signed_distance(p.vertices()[(i + 1) % n])) < tol);
@@ -136,9 +137,10 @@ TEST_CASE("polygon: bounding planes contain their edge and the normal and point 
     }
 }
 
-TEST_CASE("polygon: constructor rejects degenerate, non-planar and non-convex input",
-          "[polygon]") {
-    auto make = [](std::vector<Vec3> v) { return Polygon(v, no_uv(static_cast<int>(v.size())), 0); };
+TEST_CASE("polygon: constructor rejects degenerate, non-planar and non-convex input", "[polygon]") {
+    auto make = [](std::vector<Vec3> v) {
+        return Polygon(v, no_uv(static_cast<int>(v.size())), 0);
+    };
     CHECK_NOTHROW(make({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}));
     // Too few vertices, (u,v) count mismatch.
     CHECK_THROWS_AS(make({{0, 0, 0}, {1, 0, 0}}), CheckFailure);
@@ -191,9 +193,14 @@ TEST_CASE("polygon: ray test agrees with an independent in-plane reference", "[p
             bool must_hit = false;
             switch (kind) {
                 case 0:  // anywhere around the polygon
-                case 1: target = 1.5 * radius * Vec2{sym(rng), sym(rng)}; break;
-                case 2: target = a; must_hit = true; break;  // through a vertex
-                case 3:                                        // through an edge point
+                case 1:
+                    target = 1.5 * radius * Vec2{sym(rng), sym(rng)};
+                    break;
+                case 2:
+                    target = a;
+                    must_hit = true;
+                    break;  // through a vertex
+                case 3:     // through an edge point
                     target = a + u01(rng) * e;
                     must_hit = true;
                     break;
@@ -332,7 +339,8 @@ TEST_CASE("polygon: uv_at is barycentric on triangles and exact on linear (u,v)"
             }
             x = x / w_sum;
             int i = r % k;
-            Vec3 on_edge = p.vertices()[i] + u01(rng) * (p.vertices()[(i + 1) % k] - p.vertices()[i]);
+            Vec3 on_edge =
+                p.vertices()[i] + u01(rng) * (p.vertices()[(i + 1) % k] - p.vertices()[i]);
             for (Vec3 y : {x, on_edge}) {
                 CAPTURE(y);
                 Vec2 w = p.uv_at(y), expected = uv_of(y);
@@ -355,8 +363,11 @@ TEST_CASE("polygon: uv_at inverts the bilinear map of a quadrilateral", "[polygo
         TestPolygon tp = random_polygon(rng, {3 * sym(rng), 3 * sym(rng), 3 * sym(rng)},
                                         std::pow(10.0, sym(rng)), aspect, 4);
         std::vector<Vec2> uv{{0, 0}, {1, 0}, {1, 1}, {0, 1}};
-        if (trial % 2) uv = {{sym(rng), sym(rng)}, {sym(rng), sym(rng)}, {sym(rng), sym(rng)},
-                             {sym(rng), sym(rng)}};
+        if (trial % 2)
+            uv = {{sym(rng), sym(rng)},
+                  {sym(rng), sym(rng)},
+                  {sym(rng), sym(rng)},
+                  {sym(rng), sym(rng)}};
         Polygon p(tp.polygon.vertices(), uv, 2);
         CAPTURE(seed, trial, p);
         for (int r = 0; r < 25; ++r) {
