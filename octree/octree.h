@@ -91,8 +91,9 @@ public:
 
     /// Builds the tree. The root is the cube around the polygons' bounding box (side 1% above the
     /// box's largest extent); a node listing more than options.max_polygons_per_leaf polygons is
-    /// split into eight, unless it is at options.max_depth or the split does not pay (the
-    /// children's lists, summed, are not below four times the node's less one: see octree.cpp).
+    /// split into eight, unless it is at options.max_depth or the split does not pay: it is made
+    /// only if the children's list lengths sum to less than 4 (n - 1) for n polygons in the
+    /// node (a surface-area cost rule, see octree.cpp).
     /// Zero polygons give an empty tree whose queries always miss.
     explicit Octree(std::vector<Polygon> polygons, Options options = {});
     ~Octree();
