@@ -1,0 +1,147 @@
+// octree/octree.h - the paper's pointer octree (section 6, "Octree"): a tree of cubes linked by
+// pointers, built with the three-step node-polygon test, answering closest-hit and any-hit ray
+// queries with the bounding-plane ray-polygon test of polygon.h.
+//
+// The node-polygon test is the paper's algorithm, kept as is. Step 3 on its own is conservative:
+// it answers "meet" whenever the polygon's PLANE passes through the cube, even if the polygon
+// misses it. It never answers "apart" for a cube and polygon that meet, so at worst a node lists
+// a polygon it does not meet (a wasted ray-polygon test, never a wrong answer).
+// After steps 1 and 2, though, step 3 is exact for convex polygons. If the plane meets the cube
+// in Q and the polygon P misses the cube, some line of the plane separates P from Q while
+// touching Q, either along an edge of Q, which lies in a face of the cube (P is then beyond that
+// face: step 1 says apart), or at a vertex of Q, which lies on an edge of the cube (some plane
+// through that line parallel to a cube edge then separates, and the projection along that axis
+// is apart: step 2). The tests find no over-report against exact clipping, including polygons
+// placed in a plane through the cube right next to its cross-section, where step 3 alone errs.
+// Only the tolerances that steer rounding towards "meet" (1e-12 of the coordinates) remain.
+#pragma once
+
+#include <memory>
+#include <optional>
+#include <ostream>
+#include <vector>
+
+#include "math/vec3.h"
+#include "octree/polygon.h"
+
+namespace mbr {
+
+/// How the three-step node-polygon test decided, in the order of its steps.
+enum class NodeTestResult {
+    apart_by_bounds,      // step 1: the bounding boxes are disjoint
+    meet_by_projection,   // step 2: a projection of the polygon lies inside the node's square
+    apart_by_projection,  // step 2: a projection of the polygon is separate from the square
+    apart_by_plane,       // step 3: all eight corners strictly on one side of the plane
+    meet_by_plane,        // step 3: corners on both sides (or on the plane)
+};
+/// The name of the enumerator, for messages.
+const char* to_string(NodeTestResult result);
+
+/// How a projection of a polygon relates to a square of the node, as Warnock's algorithm sorts a
+/// polygon against a window: contained, disjoint, or neither (intersecting or surrounding).
+enum class ProjectionRelation { inside, apart, undecided };
+
+/// Step 2 for one axis plane: axis 2 projects onto xy, 0 onto yz, 1 onto zx. Warnock's tests:
+/// every vertex inside the (closed) square -> inside; else an edge meeting the square ->
+/// undecided; else (no edge meets it) the square is either inside the polygon (its centre is in
+/// the polygon: surrounding -> undecided) or apart. Decisions lean to "undecided" by a tolerance
+/// of 1e-12 x the coordinates' magnitude, so rounding never produces a false "apart".
+ProjectionRelation projection_relation(const Box3& cube, const Polygon& polygon, int axis);
+
+/// The paper's three-step node-polygon test with the step that decided (see node_meets_polygon).
+NodeTestResult classify_node_polygon(const Box3& cube, const Polygon& polygon);
+
+/// The paper's node-polygon test: (1) disjoint bounding boxes -> apart; (2) over the projections
+/// onto xy, yz and zx, one inside its square -> meet, one apart from it -> apart; (3) all eight
+/// corners strictly on one side of the polygon's plane -> apart, else meet. Never a false
+/// "apart"; exact for convex polygons up to 1e-12 of the coordinates (see the file comment).
+/// Touching counts as meeting.
+bool node_meets_polygon(const Box3& cube, const Polygon& polygon);
+
+/// A ray's first intersection: which polygon, its surface, the surface's (u, v) there, and t.
+struct Hit {
+    int polygon = -1;  // index into Octree::polygons()
+    int surface = -1;  // Polygon::surface() of that polygon
+    Vec2 uv;           // Polygon::uv_at() of the hit point
+    double t = 0;      // ray parameter, in units of ray.dir
+};
+/// Prints the fields of a hit.
+std::ostream& operator<<(std::ostream& os, const Hit& hit);
+
+/// Work done by ray queries; each query adds to the counters it is given.
+struct RayStats {
+    long n_nodes_visited = 0;    // octree nodes entered (root included)
+    long n_polygons_tested = 0;  // ray-polygon tests performed
+    /// Adds another query's (or thread's) counts.
+    RayStats& operator+=(const RayStats& other);
+};
+
+/// Build options of the octree.
+struct OctreeOptions {
+    int max_depth = 10;             // depth of the deepest allowed node (the root has depth 0)
+    int max_polygons_per_leaf = 8;  // a node listing more is split (below max_depth, if it pays)
+};
+
+/// The paper's pointer octree over a set of polygons. Immutable after construction; its queries
+/// keep all state on the stack, so any number of threads may query one octree at once.
+class Octree {
+public:
+    /// Build options.
+    using Options = OctreeOptions;
+
+    /// Builds the tree. The root is the cube around the polygons' bounding box (side 1% above the
+    /// box's largest extent); a node listing more than options.max_polygons_per_leaf polygons is
+    /// split into eight, unless it is at options.max_depth or the split does not pay: it is made
+    /// only if the children's list lengths sum to less than 4 (n - 1) for n polygons in the
+    /// node (a surface-area cost rule, see octree.cpp).
+    /// Zero polygons give an empty tree whose queries always miss.
+    explicit Octree(std::vector<Polygon> polygons, Options options = {});
+    ~Octree();
+    Octree(Octree&&) noexcept;
+    Octree& operator=(Octree&&) noexcept;
+
+    /// The first hit along the ray with t in [ray.t_min, ray.t_max]; among hits at the same t,
+    /// the polygon with the smallest index. Visits nodes front to back and stops at the first
+    /// node that starts beyond the best hit so far. Adds its work to *stats if given.
+    std::optional<Hit> closest_hit(const Ray& ray, RayStats* stats = nullptr) const;
+    /// Whether any polygon is hit with t in [ray.t_min, ray.t_max] (shadow rays). Stops at the
+    /// first hit found. Adds its work to *stats if given.
+    bool any_hit(const Ray& ray, RayStats* stats = nullptr) const;
+
+    /// The polygons, in the order given to the constructor (Hit::polygon indexes them).
+    const std::vector<Polygon>& polygons() const { return polygons_; }
+    /// Number of polygons.
+    int polygon_count() const { return static_cast<int>(polygons_.size()); }
+    /// The root cube (an empty box when there are no polygons).
+    Box3 bounds() const { return root_cube_; }
+    /// Number of nodes, root included (0 for an empty tree). Children that would meet no polygon
+    /// are not allocated.
+    int node_count() const { return node_count_; }
+    /// Number of leaves.
+    int leaf_count() const { return leaf_count_; }
+    /// Depth of the deepest node (0 when the root is a leaf).
+    int depth() const { return depth_; }
+    /// Sum over the leaves of the number of polygons each lists.
+    long reference_count() const { return reference_count_; }
+    /// The options the tree was built with.
+    const Options& options() const { return options_; }
+
+private:
+    struct Node;
+    struct Query;
+    std::unique_ptr<Node> build(const Box3& cube, std::vector<int> ids, int depth);
+    Box3 grown(const Box3& cube) const;
+    bool traverse(const Node& node, const Box3& cube, Query& query) const;
+
+    std::vector<Polygon> polygons_;
+    Options options_;
+    Box3 root_cube_;
+    double margin_ = 0;  // every node cube grows by this much for building and traversal
+    std::unique_ptr<Node> root_;
+    int node_count_ = 0;
+    int leaf_count_ = 0;
+    int depth_ = 0;
+    long reference_count_ = 0;
+};
+
+}  // namespace mbr

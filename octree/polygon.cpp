@@ -1,0 +1,203 @@
+// octree/polygon.cpp - planar convex polygons, their bounding planes (Figure 6) and the paper's
+// ray-polygon test (section 6, "Octree"); plus (u, v) interpolation for hit points.
+#include "octree/polygon.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "math/check.h"
+
+namespace mbr {
+
+namespace {
+
+// Relative tolerances of the constructor's checks (in units of the diameter, or radians).
+constexpr double planarity_tol = 1e-6;    // vertex distance from the plane / diameter
+constexpr double convexity_tol = 1e-7;    // largest allowed right turn (radians)
+constexpr double degeneracy_tol = 1e-12;  // shortest edge / diameter; area / diameter^2
+// DESIGN: the closed inside test's slack, relative to the diameter (see polygon.h).
+constexpr double edge_slack_rel = 1e-10;
+
+}  // namespace
+
+std::ostream& operator<<(std::ostream& os, const Ray& ray) {
+    return os << "ray(" << ray.origin << " + t " << ray.dir << ", t in [" << ray.t_min << ", "
+              << ray.t_max << "])";
+}
+
+std::ostream& operator<<(std::ostream& os, const Polygon& polygon) {
+    os << "polygon(surface " << polygon.surface() << ':';
+    for (Vec3 v : polygon.vertices()) os << ' ' << v;
+    return os << ')';
+}
+
+Polygon::Polygon(std::vector<Vec3> vertices, std::vector<Vec2> uv, int surface)
+    : vertices_(std::move(vertices)), uv_(std::move(uv)), surface_(surface) {
+    const int n = n_vertices();
+    MBR_CHECK_MSG(n >= 3, "a polygon needs at least 3 vertices, got " << n);
+    MBR_CHECK_MSG(uv_.size() == vertices_.size(), uv_.size()
+                                                      << " (u,v) pairs for " << n << " vertices");
+    for (Vec3 v : vertices_) MBR_CHECK_MSG(is_finite(v), "vertex " << v);
+    for (Vec3 v : vertices_) bounds_.extend(v);
+    for (int i = 0; i < n; ++i)
+        for (int j = i + 1; j < n; ++j)
+            diameter_ = std::max(diameter_, length(vertices_[j] - vertices_[i]));
+    MBR_CHECK_MSG(diameter_ > 0, "all vertices coincide at " << vertices_[0]);
+
+    // Newell's normal: sum of cross products about vertex 0, twice the vector area. Its direction
+    // is the side from which the vertices run counter-clockwise.
+    Vec3 area_vector;
+    for (int i = 1; i + 1 < n; ++i)
+        area_vector += cross(vertices_[i] - vertices_[0], vertices_[i + 1] - vertices_[0]);
+    area_ = 0.5 * length(area_vector);
+    MBR_CHECK_MSG(area_ > degeneracy_tol * diameter_ * diameter_, "zero-area polygon " << *this);
+    Vec3 n_p = normalize(area_vector);
+    Vec3 centroid;
+    for (Vec3 v : vertices_) centroid += v;
+    centroid = centroid / n;
+    plane_ = Plane{n_p, dot(n_p, centroid)};
+    for (Vec3 v : vertices_)
+        planarity_error_ = std::max(planarity_error_, std::fabs(plane_.signed_distance(v)));
+    for (Vec3 v : vertices_)
+        MBR_CHECK_MSG(std::fabs(plane_.signed_distance(v)) <= planarity_tol * diameter_,
+                      "non-planar polygon " << *this << ": vertex " << v << " is "
+                                            << plane_.signed_distance(v) << " off its plane");
+
+    // Convexity: every turn is to the left (about n_p) or straight, and the turns add up to one
+    // full circle (which rules out star-shaped windings whose turns are all left).
+    double total_turn = 0;
+    for (int i = 0; i < n; ++i) {
+        Vec3 a = vertices_[i] - vertices_[(i + n - 1) % n];
+        Vec3 b = vertices_[(i + 1) % n] - vertices_[i];
+        MBR_CHECK_MSG(length(b) > degeneracy_tol * diameter_,
+                      "zero-length edge at vertex " << i << " of " << *this);
+        double turn = std::atan2(dot(n_p, cross(a, b)), dot(a, b));
+        MBR_CHECK_MSG(
+            turn >= -convexity_tol && turn < Pi - convexity_tol,
+            "non-convex polygon " << *this << ": turn of " << turn << " rad at vertex " << i);
+        total_turn += turn;
+    }
+    MBR_CHECK_MSG(std::fabs(total_turn - 2 * Pi) < 1e-6,
+                  "polygon " << *this << " winds " << total_turn / (2 * Pi) << " times");
+
+    // Figure 6: bounding plane through edge (v_i, v_i+1) containing the normal. With the vertices
+    // counter-clockwise about n_p, edge x n_p points away from the polygon.
+    bounding_planes_.reserve(n);
+    for (int i = 0; i < n; ++i) {
+        Vec3 edge = vertices_[(i + 1) % n] - vertices_[i];
+        Vec3 outward = normalize(cross(edge, n_p));
+        bounding_planes_.push_back(Plane{outward, dot(outward, vertices_[i])});
+    }
+    edge_slack_ = edge_slack_rel * diameter_;
+
+    axis_u_ = normalize(vertices_[1] - vertices_[0]);
+    axis_v_ = cross(n_p, axis_u_);
+    local_.reserve(n);
+    for (Vec3 v : vertices_) local_.push_back(to_local(v));
+}
+
+bool Polygon::contains(Vec3 p) const {
+    // Step 2 of the paper's test: substitute p into each bounding plane's equation. The paper asks
+    // for all results negative (open polygon); we accept up to +edge_slack_ (closed, see header).
+    // Written as !(d <= slack) so that a NaN counts as outside.
+    for (const Plane& b : bounding_planes_)
+        if (!(b.signed_distance(p) <= edge_slack_)) return false;
+    return true;
+}
+
+std::optional<double> Polygon::intersect(const Ray& ray) const {
+    // Step 1: the ray meets the polygon's plane at t = (offset - n.o) / n.d.
+    double denom = dot(plane_.normal, ray.dir);
+    if (denom == 0) return std::nullopt;  // parallel (or in the plane): a miss by convention
+    double t = -plane_.signed_distance(ray.origin) / denom;
+    if (!std::isfinite(t) || t < ray.t_min || t > ray.t_max) return std::nullopt;
+    if (!contains(ray.at(t))) return std::nullopt;
+    return t;
+}
+
+Vec2 Polygon::to_local(Vec3 p) const {
+    Vec3 d = p - vertices_[0];
+    return {dot(d, axis_u_), dot(d, axis_v_)};
+}
+
+Vec2 Polygon::uv_at(Vec3 p) const {
+    Vec2 q = to_local(p);
+    if (n_vertices() == 3) {
+        // Barycentric coordinates from signed areas of the sub-triangles opposite each vertex.
+        double a = cross(local_[1] - local_[0], local_[2] - local_[0]);
+        double b0 = cross(local_[1] - q, local_[2] - q) / a;
+        double b1 = cross(local_[2] - q, local_[0] - q) / a;
+        double b2 = 1 - b0 - b1;
+        return b0 * uv_[0] + b1 * uv_[1] + b2 * uv_[2];
+    }
+    if (n_vertices() == 4) return uv_quad(q);
+    return uv_mean_value(q);
+}
+
+Vec2 Polygon::uv_quad(Vec2 q) const {
+    // Inverse of the bilinear map P(s,t) = q0 + s e + t f + s t g with corners q0, q1, q2, q3 at
+    // (s,t) = (0,0), (1,0), (1,1), (0,1). Eliminating s from q - q0 - t f = s (e + t g) leaves
+    // k2 t^2 + k1 t + k0 = 0 (as in Quilez's inverse bilinear interpolation).
+    const Vec2 q0 = local_[0], q1 = local_[1], q2 = local_[2], q3 = local_[3];
+    Vec2 e = q1 - q0, f = q3 - q0, g = q0 - q1 + q2 - q3, h = q - q0;
+    double k2 = cross(g, f);
+    double k1 = cross(h, g) + cross(e, f);
+    double k0 = cross(h, e);
+    // Stable roots q_r / k2 and k0 / q_r; for a parallelogram k2 = 0 and only k0 / q_r is finite.
+    double disc = std::max(0.0, k1 * k1 - 4 * k0 * k2);  // < 0 only outside: take the vertex
+    double q_r = -0.5 * (k1 + std::copysign(std::sqrt(disc), k1));
+    double t = 0;
+    if (q_r != 0) {
+        double r1 = k0 / q_r;
+        double r2 = k2 != 0 ? q_r / k2 : HUGE_VAL;
+        // Pick the root in [0, 1], or the nearer one to that interval when extrapolating.
+        auto off = [](double r) { return r < 0 ? -r : (r > 1 ? r - 1 : 0.0); };
+        t = off(r1) <= off(r2) ? r1 : r2;
+    }
+    Vec2 d = e + t * g;
+    double s = dot(h - t * f, d) / dot(d, d);
+    // Two Newton steps on P(s,t) = q polish the rounding of the closed form.
+    for (int it = 0; it < 2; ++it) {
+        Vec2 r = q0 + s * e + t * f + (s * t) * g - q;
+        Vec2 ps = e + t * g, pt = f + s * g;
+        double det = cross(ps, pt);
+        if (det == 0) break;
+        s -= cross(r, pt) / det;
+        t -= cross(ps, r) / det;
+    }
+    return (1 - s) * (1 - t) * uv_[0] + s * (1 - t) * uv_[1] + s * t * uv_[2] +
+           (1 - s) * t * uv_[3];
+}
+
+Vec2 Polygon::uv_mean_value(Vec2 q) const {
+    // Mean-value coordinates in the form of Hormann and Floater (2006), which needs no angles and
+    // handles points on a vertex or an edge explicitly.
+    const int n = n_vertices();
+    std::vector<Vec2> s(n);
+    std::vector<double> r(n), a(n), d(n);
+    for (int i = 0; i < n; ++i) {
+        s[i] = local_[i] - q;
+        r[i] = std::sqrt(dot(s[i], s[i]));
+        if (r[i] == 0) return uv_[i];
+    }
+    for (int i = 0; i < n; ++i) {
+        int j = (i + 1) % n;
+        a[i] = 0.5 * cross(s[i], s[j]);
+        d[i] = dot(s[i], s[j]);
+        if (a[i] == 0 && d[i] < 0)  // on edge (i, j): linear along it
+            return (1 / (r[i] + r[j])) * (r[j] * uv_[i] + r[i] * uv_[j]);
+    }
+    Vec2 sum;
+    double w_sum = 0;
+    for (int i = 0; i < n; ++i) {
+        int prev = (i + n - 1) % n, next = (i + 1) % n;
+        double w = 0;
+        if (a[prev] != 0) w += (r[prev] - d[prev] / r[i]) / a[prev];
+        if (a[i] != 0) w += (r[next] - d[i] / r[i]) / a[i];
+        sum = sum + w * uv_[i];
+        w_sum += w;
+    }
+    return (1 / w_sum) * sum;
+}
+
+}  // namespace mbr
