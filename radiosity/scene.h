@@ -32,19 +32,19 @@ struct SceneSurface {
 
 /// A pinhole camera. A right-handed frame: the image's right is (look_at - eye) x up.
 struct Camera {
-    Vec3 eye{0, 0, 1};         // centre of projection
-    Vec3 look_at{0, 0, 0};     // a point on the optical axis
-    Vec3 up{0, 1, 0};          // projects to the image's upward direction
-    double fov_degrees = 45;   // vertical field of view, in (0, 180)
-    int width = 512;           // image size in pixels
-    int height = 512;
+    Vec3 eye{0, 0, 1};        // centre of projection
+    Vec3 look_at{0, 0, 0};    // a point on the optical axis
+    Vec3 up{0, 1, 0};         // projects to the image's upward direction
+    double fov_degrees = 45;  // vertical field of view, in (0, 180)
+    int width = 512;          // image size in pixels
+    int height = 512;         // (the aspect ratio is width / height)
 };
 
 /// Options of the solver: the progressive loop (section 4) and one transfer (section 5).
 struct SolverSettings {
     int order = 4;                         // B-spline order m (degree m - 1); the paper uses 4, 3
     int min_depth = 1;                     // oracle quadtree bounds; min = max = d is uniform
-    int max_depth = 6;
+    int max_depth = 6;                     // (d = subdivisions below the root: leaves 2^-d wide)
     double oracle_tolerance = 1e-3;        // relative agreement of the two Gauss-Legendre rules
     double truncation_eps = 1e-6;          // relative cut-off of |DN x DN| (rhombus, Figure 3)
     double rhombus_radius = 0;             // in cells; 0: derived from truncation_eps

@@ -32,12 +32,12 @@ const char* const obj_default_material = "obj_default";
 // ---------------------------------------------------------------------------------------------
 // === Lines and tokens
 
-/// A token for a message: quoted, at most 40 characters, bytes outside printable ASCII as \xHH.
+/// A token for a message: quoted, at most 256 characters, bytes outside printable ASCII as \xHH.
 std::string in_quotes(const std::string& s) {
     std::string out = "'";
     size_t n = 0;
     for (unsigned char c : s) {
-        if (++n > 40) {
+        if (++n > 256) {
             out += "...";
             break;
         }
@@ -125,8 +125,9 @@ private:
             }
             if (c == '\n') return true;
             if (raw.size() >= max_line_length)
-                throw InputError(file_, number_, "line is longer than " +
-                                                     std::to_string(max_line_length) + " bytes");
+                throw InputError(
+                    file_, number_,
+                    "line is longer than " + std::to_string(max_line_length) + " bytes");
             raw += char(c);
         }
     }
@@ -174,10 +175,17 @@ long long parse_integer(const Line& line, const std::string& token, const std::s
     return x;
 }
 
+/// True for tokens meant as numbers (including NaN and infinity, which parse_double refuses
+/// with their own message).
 bool is_number_token(const std::string& t) {
     if (t.empty()) return false;
     char c = t[0];
-    return std::isdigit(static_cast<unsigned char>(c)) || c == '-' || c == '+' || c == '.';
+    if (std::isdigit(static_cast<unsigned char>(c)) || c == '-' || c == '+' || c == '.')
+        return true;
+    std::string lower;
+    for (char ch : t) lower += char(std::tolower(static_cast<unsigned char>(ch)));
+    return lower == "nan" || lower == "inf" || lower == "infinity" ||
+           lower.compare(0, 4, "nan(") == 0;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -302,7 +310,9 @@ void check_angle_range(const Line& line, double a0, double a1, const std::string
                   fmt(span_limit) + " degrees");
 }
 
-double radians(double degrees) { return degrees * (Pi / 180); }
+double radians(double degrees) {
+    return degrees * (Pi / 180);
+}
 
 // ---------------------------------------------------------------------------------------------
 // === Numbers of one statement
@@ -354,7 +364,9 @@ std::vector<double> read_fields(const Line& line, size_t first, const std::strin
     return x;
 }
 
-Vec3 vec_at(const std::vector<double>& x, size_t i) { return {x[i], x[i + 1], x[i + 2]}; }
+Vec3 vec_at(const std::vector<double>& x, size_t i) {
+    return {x[i], x[i + 1], x[i + 2]};
+}
 
 }  // namespace
 
@@ -409,15 +421,45 @@ void triangle_to_quads(Vec3 a, Vec3 b, Vec3 c, std::vector<Quad>& out) {
     out.push_back({c, m_ca, g, m_bc});
 }
 
-/// Ear clipping in the plane normal to n, choosing the ear with the shortest new diagonal.
-/// Returns false when no ear exists (the projected polygon intersects itself).
-bool triangulate(std::vector<Vec3> p, Vec3 n, std::vector<std::array<Vec3, 3>>& triangles) {
-    // An orthonormal basis of the plane; the projection keeps the polygon counter-clockwise.
-    Vec3 t1 = std::fabs(n.x) < 0.9 ? cross(n, Vec3{1, 0, 0}) : cross(n, Vec3{0, 1, 0});
-    t1 = normalize(t1);
+/// Projects a polygon onto the plane normal to the unit vector n (counter-clockwise about n).
+std::vector<Vec2> project(const std::vector<Vec3>& p, Vec3 n) {
+    Vec3 t1 = normalize(std::fabs(n.x) < 0.9 ? cross(n, Vec3{1, 0, 0}) : cross(n, Vec3{0, 1, 0}));
     Vec3 t2 = cross(n, t1);
     std::vector<Vec2> q;
     for (const Vec3& x : p) q.push_back({dot(x, t1), dot(x, t2)});
+    return q;
+}
+
+/// True when no two edges of the closed 2D polygon meet except adjacent ones at their shared
+/// corner (touching counts as meeting).
+bool is_simple(const std::vector<Vec2>& q) {
+    auto orient = [](Vec2 a, Vec2 b, Vec2 c) {
+        double d = cross(b - a, c - a);
+        return d > 0 ? 1 : (d < 0 ? -1 : 0);
+    };
+    auto on_segment = [](Vec2 a, Vec2 b, Vec2 c) {  // c collinear with a, b: within the box?
+        return std::min(a.x, b.x) <= c.x && c.x <= std::max(a.x, b.x) &&
+               std::min(a.y, b.y) <= c.y && c.y <= std::max(a.y, b.y);
+    };
+    auto meet = [&](Vec2 a, Vec2 b, Vec2 c, Vec2 d) {
+        int o1 = orient(a, b, c), o2 = orient(a, b, d), o3 = orient(c, d, a), o4 = orient(c, d, b);
+        if (o1 != o2 && o3 != o4) return true;
+        return (o1 == 0 && on_segment(a, b, c)) || (o2 == 0 && on_segment(a, b, d)) ||
+               (o3 == 0 && on_segment(c, d, a)) || (o4 == 0 && on_segment(c, d, b));
+    };
+    size_t k = q.size();
+    for (size_t i = 0; i < k; ++i)
+        for (size_t j = i + 2; j < k; ++j) {
+            if (i == 0 && j == k - 1) continue;  // adjacent through the wrap
+            if (meet(q[i], q[(i + 1) % k], q[j], q[(j + 1) % k])) return false;
+        }
+    return true;
+}
+
+/// Ear clipping in the plane normal to n, choosing the ear with the shortest new diagonal.
+/// Returns false when no ear exists. Expects a simple polygon (is_simple).
+bool triangulate(std::vector<Vec3> p, Vec3 n, std::vector<std::array<Vec3, 3>>& triangles) {
+    std::vector<Vec2> q = project(p, n);
     auto inside = [](Vec2 a, Vec2 b, Vec2 c, Vec2 x) {
         // Closed triangle test (points on the edges count as inside, which blocks the ear).
         return cross(b - a, x - a) >= 0 && cross(c - b, x - b) >= 0 && cross(a - c, x - c) >= 0;
@@ -518,7 +560,7 @@ std::vector<Quad> face_to_quads(const Line& line, std::vector<Vec3> p) {
         }
     }
     std::vector<std::array<Vec3, 3>> triangles;
-    if (!triangulate(p, n, triangles))
+    if (!is_simple(project(p, n)) || !triangulate(p, n, triangles))
         line.fail("face of " + std::to_string(p.size()) +
                   " vertices intersects itself (it cannot be triangulated)");
     for (const auto& t : triangles)
@@ -607,8 +649,8 @@ private:
             // Display and grouping attributes that do not matter for radiosity.
         } else if (key == "cstype" || key == "deg" || key == "bmat" || key == "step" ||
                    key == "curv" || key == "curv2" || key == "surf" || key == "parm" ||
-                   key == "trim" || key == "hole" || key == "scrv" || key == "sp" ||
-                   key == "end" || key == "con") {
+                   key == "trim" || key == "hole" || key == "scrv" || key == "sp" || key == "end" ||
+                   key == "con") {
             line.fail("free-form geometry (" + in_quotes(key) + ") is not supported");
         } else {
             line.fail("unknown OBJ statement " + in_quotes(key));
@@ -649,7 +691,8 @@ private:
                 line.fail("malformed face vertex " + in_quotes(ref) +
                           " (expected v, v/vt, v//vn or v/vt/vn)");
             p.push_back(v_[size_t(index(line, parts[0], long(v_.size()), "vertex"))]);
-            if (parts.size() >= 2 && !parts[1].empty()) index(line, parts[1], n_vt_, "texture vertex");
+            if (parts.size() >= 2 && !parts[1].empty())
+                index(line, parts[1], n_vt_, "texture vertex");
             if (parts.size() == 3) index(line, parts[2], n_vn_, "normal");
         }
         if (material_ < 0) material_ = default_material();
@@ -708,7 +751,8 @@ private:
     /// "Kd r g b" or "Kd r" (grey); spectral and CIE XYZ forms are refused.
     static Rgb mtl_colour(const Line& line) {
         if (line.size() >= 2 && (line[1] == "spectral" || line[1] == "xyz"))
-            line.fail(in_quotes(line[0]) + " " + line[1] + " colours are not supported; give r g b");
+            line.fail(in_quotes(line[0]) + " " + line[1] +
+                      " colours are not supported; give r g b");
         if (line.size() != 2 && line.size() != 4)
             line.fail(in_quotes(line[0]) + " needs 1 or 3 numbers (r g b), found " +
                       std::to_string(line.size() - 1));
@@ -744,8 +788,8 @@ private:
             if (line.size() >= 2 && (line[1] == "spectral" || line[1] == "xyz")) return;
             mtl_colour(line);
         } else if (key == "Ns" || key == "Ni" || key == "Tr" || key == "illum" ||
-                   key == "sharpness" || key == "Pr" || key == "Pm" || key == "Ps" ||
-                   key == "Pc" || key == "Pcr" || key == "aniso" || key == "anisor") {
+                   key == "sharpness" || key == "Pr" || key == "Pm" || key == "Ps" || key == "Pc" ||
+                   key == "Pcr" || key == "aniso" || key == "anisor") {
             if (line.size() != 2)
                 line.fail(in_quotes(key) + " needs one number, found " +
                           std::to_string(line.size() - 1));
@@ -861,12 +905,13 @@ private:
     void material(const Line& line) {
         if (line.size() < 2) line.fail("'material' needs a name");
         const std::string& name = line[1];
-        if (is_number_token(name)) line.fail("material name " + in_quotes(name) + " looks like a number");
+        if (is_number_token(name))
+            line.fail("material name " + in_quotes(name) + " looks like a number");
         auto seen = material_lines_.find(name);
         if (seen != material_lines_.end() || scene_.find_material(name) >= 0)
             line.fail("duplicate material " + in_quotes(name) +
                       (seen != material_lines_.end() ? " (first defined at " + seen->second + ")"
-                                                      : std::string(" (defined by an OBJ file)")));
+                                                     : std::string(" (defined by an OBJ file)")));
         Material m;
         m.name = name;
         bool has_reflectance = false, has_emission = false;
@@ -914,7 +959,8 @@ private:
     /// R G B | checker N R G B R G B | image FILE [scale R G B], starting at tokens[t].
     Texture texture(const Line& line, size_t& t, bool reflectance) {
         const std::string role = reflectance ? "reflectance" : "emission";
-        if (t >= line.size()) line.fail(in_quotes(role) + " needs a value (r g b, checker or image)");
+        if (t >= line.size())
+            line.fail(in_quotes(role) + " needs a value (r g b, checker or image)");
         const std::string& kind = line[t];
         if (kind == "checker") {
             ++t;
@@ -946,7 +992,8 @@ private:
             return tex;
         }
         if (!is_number_token(kind))
-            line.fail(in_quotes(role) + " expects r g b, 'checker' or 'image', found " + in_quotes(kind));
+            line.fail(in_quotes(role) + " expects r g b, 'checker' or 'image', found " +
+                      in_quotes(kind));
         return Texture::constant(colour(line, t, role, reflectance));
     }
 
@@ -1006,8 +1053,13 @@ private:
             box(line, name, material, vec_at(x, 0), vec_at(x, 3), inward);
         } else if (kind == "cylinder") {
             auto x = read_fields(line, 3, kind,
-                                 {{"base", 3}, {"axis", 3}, {"e1", 3}, {"radius", 1},
-                                  {"height", 1}, {"phi0", 1}, {"phi1", 1}},
+                                 {{"base", 3},
+                                  {"axis", 3},
+                                  {"e1", 3},
+                                  {"radius", 1},
+                                  {"height", 1},
+                                  {"phi0", 1},
+                                  {"phi1", 1}},
                                  "inward", &inward);
             Vec3 base = vec_at(x, 0), axis = vec_at(x, 3), e1 = vec_at(x, 6);
             check_point(line, base, "base");
@@ -1017,13 +1069,19 @@ private:
             double r = check_length(line, x[9], "radius", false);
             double h = check_length(line, x[10], "height", false);
             check_angle_range(line, x[11], x[12], "phi", 360);
-            add_surface(line, name, material,
-                        Surface::cylinder(base, axis, e1, r, h, radians(x[11]), radians(x[12]),
-                                          inward));
+            add_surface(
+                line, name, material,
+                Surface::cylinder(base, axis, e1, r, h, radians(x[11]), radians(x[12]), inward));
         } else if (kind == "sphere") {
             auto x = read_fields(line, 3, kind,
-                                 {{"centre", 3}, {"pole", 3}, {"e1", 3}, {"radius", 1},
-                                  {"theta0", 1}, {"theta1", 1}, {"phi0", 1}, {"phi1", 1}},
+                                 {{"centre", 3},
+                                  {"pole", 3},
+                                  {"e1", 3},
+                                  {"radius", 1},
+                                  {"theta0", 1},
+                                  {"theta1", 1},
+                                  {"phi0", 1},
+                                  {"phi1", 1}},
                                  "inward", &inward);
             Vec3 centre = vec_at(x, 0), pole = vec_at(x, 3), e1 = vec_at(x, 6);
             check_point(line, centre, "centre");
@@ -1041,8 +1099,13 @@ private:
                                         radians(x[12]), radians(x[13]), inward));
         } else {  // disk
             auto x = read_fields(line, 3, kind,
-                                 {{"centre", 3}, {"normal", 3}, {"e1", 3}, {"r0", 1}, {"r1", 1},
-                                  {"phi0", 1}, {"phi1", 1}});
+                                 {{"centre", 3},
+                                  {"normal", 3},
+                                  {"e1", 3},
+                                  {"r0", 1},
+                                  {"r1", 1},
+                                  {"phi0", 1},
+                                  {"phi1", 1}});
             Vec3 centre = vec_at(x, 0), normal = vec_at(x, 3), e1 = vec_at(x, 6);
             check_point(line, centre, "centre");
             check_direction(line, normal, "normal");
@@ -1119,9 +1182,9 @@ private:
         for (size_t t = 1; t < line.size();) {
             const std::string clause = line[t++];
             int n = clause == "eye" || clause == "look_at" || clause == "up" ? 3
-                    : clause == "fov"                                          ? 1
-                    : clause == "size"                                         ? 2
-                                                                               : 0;
+                    : clause == "fov"                                        ? 1
+                    : clause == "size"                                       ? 2
+                                                                             : 0;
             if (n == 0) {
                 if (is_number_token(clause))
                     line.fail("unexpected number " + in_quotes(clause) +
@@ -1173,7 +1236,8 @@ private:
                       " words");
         const std::string& key = line[1];
         const std::string& value = line[2];
-        if (!settings_seen_.insert(key).second) line.fail("setting " + in_quotes(key) + " is given twice");
+        if (!settings_seen_.insert(key).second)
+            line.fail("setting " + in_quotes(key) + " is given twice");
         SolverSettings& s = scene_.settings;
         auto integer = [&](long long lo, long long hi) {
             return int(parse_integer(line, value, key, lo, hi));
@@ -1201,7 +1265,8 @@ private:
             s.rhombus_radius = real(0, 1000, false, false);
         } else if (key == "extrapolation") {
             if (value != "linear" && value != "higher")
-                line.fail("extrapolation " + in_quotes(value) + " is neither 'linear' nor 'higher'");
+                line.fail("extrapolation " + in_quotes(value) +
+                          " is neither 'linear' nor 'higher'");
             s.extrapolation = value;
         } else if (key == "shadow_rays") {
             s.shadow_rays = integer(1, 4096);
@@ -1276,7 +1341,7 @@ private:
 
     FileBudget& budget_;
     Scene scene_;
-    std::vector<std::string> stack_;                  // canonical names of the open files
+    std::vector<std::string> stack_;  // canonical names of the open files
     std::map<std::string, std::string> material_lines_, surface_lines_;  // name -> file:line
     std::set<std::string> settings_seen_;
     int camera_line_ = 0;

@@ -13,11 +13,17 @@ namespace mbr {
 
 namespace {
 
-Rgb channel_min(Rgb a, Rgb b) { return {std::min(a.r, b.r), std::min(a.g, b.g), std::min(a.b, b.b)}; }
-Rgb channel_max(Rgb a, Rgb b) { return {std::max(a.r, b.r), std::max(a.g, b.g), std::max(a.b, b.b)}; }
+Rgb channel_min(Rgb a, Rgb b) {
+    return {std::min(a.r, b.r), std::min(a.g, b.g), std::min(a.b, b.b)};
+}
+Rgb channel_max(Rgb a, Rgb b) {
+    return {std::max(a.r, b.r), std::max(a.g, b.g), std::max(a.b, b.b)};
+}
 
 /// Clamps to [0,1]; NaN becomes 0 so that a bad argument can never index outside the texels.
-double clamp01(double x) { return x >= 0 ? (x <= 1 ? x : 1.0) : 0.0; }
+double clamp01(double x) {
+    return x >= 0 ? (x <= 1 ? x : 1.0) : 0.0;
+}
 
 }  // namespace
 
@@ -75,18 +81,21 @@ Texture Texture::image(const std::string& path, Rgb scale) {
         if (!f) throw InputError(path, 0, "cannot open the texture file");
         std::fclose(f);
         const char* why = stbi_failure_reason();
-        throw InputError(path, 0, std::string("cannot read the texture image (") +
-                                      (why ? why : "unknown format") + ")");
+        throw InputError(
+            path, 0,
+            std::string("cannot read the texture image (") + (why ? why : "unknown format") + ")");
     }
     if (width < 1 || height < 1 || long(width) * long(height) > max_image_pixels)
-        throw InputError(path, 0, "texture image is " + std::to_string(width) + " x " +
-                                      std::to_string(height) + " pixels; at most " +
-                                      std::to_string(max_image_pixels) + " pixels are accepted");
+        throw InputError(path, 0,
+                         "texture image is " + std::to_string(width) + " x " +
+                             std::to_string(height) + " pixels; at most " +
+                             std::to_string(max_image_pixels) + " pixels are accepted");
     unsigned char* data = stbi_load(path.c_str(), &width, &height, &channels, 3);
     if (!data) {
         const char* why = stbi_failure_reason();
-        throw InputError(path, 0, std::string("cannot decode the texture image (") +
-                                      (why ? why : "unknown error") + ")");
+        throw InputError(
+            path, 0,
+            std::string("cannot decode the texture image (") + (why ? why : "unknown error") + ")");
     }
     // sRGB decoding of the 256 possible 8-bit values, once.
     double table[256];

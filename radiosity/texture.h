@@ -60,8 +60,8 @@ private:
         Rgb mean, lo, hi;
     };
     Kind kind_ = Kind::Constant;
-    Rgb a_, b_;   // constant value; checker colours
-    int n_ = 0;   // checker squares per side
+    Rgb a_, b_;  // constant value; checker colours
+    int n_ = 0;  // checker squares per side
     std::shared_ptr<const Pixels> pixels_;
     std::string source_;
 };

@@ -3,7 +3,6 @@
 // finite differences of x(u,v), normals are unit and equal to x_u x x_v normalised, and
 // tessellation facets are planar, lie on (or, for curved kinds, near) the surface and cover it.
 #include <catch2/catch.hpp>
-
 #include <string>
 #include <vector>
 
@@ -14,7 +13,9 @@ using namespace mbr;
 
 namespace {
 
-double deg(double d) { return d * Pi / 180; }
+double deg(double d) {
+    return d * Pi / 180;
+}
 
 /// A surface with its closed-form area and a label for messages.
 struct Case {
@@ -33,8 +34,7 @@ std::vector<Case> cases() {
         {"trapezoid",
          Surface::planar_quad({0, 0, 0}, {3, 0, 0}, {2, 2 * 0.6, 2 * 0.8}, {1, 2 * 0.6, 2 * 0.8}),
          4.0},
-        {"bilinear z = xy",
-         Surface::bilinear_patch({0, 0, 0}, {1, 0, 0}, {1, 1, 1}, {0, 1, 0}),
+        {"bilinear z = xy", Surface::bilinear_patch({0, 0, 0}, {1, 0, 0}, {1, 1, 1}, {0, 1, 0}),
          std::sqrt(3.0) / 3 + 2.0 / 3 * std::log(2 + std::sqrt(3.0)) - Pi / 18},
         {"cylinder patch",
          Surface::cylinder({0.1, 0.2, 0.3}, {0, 0, 2}, {1, 0, 0}, r, h, deg(30), deg(200)),
@@ -156,8 +156,7 @@ TEST_CASE("surface: curved kinds face outward unless inward, disks face their no
     CHECK(length(q.normal(0.3, 0.6) - Vec3{0, 0, -1}) < 1e-15);
 }
 
-TEST_CASE("surface: tessellation facets are planar, lie on the surface and cover it",
-          "[surface]") {
+TEST_CASE("surface: tessellation facets are planar, lie on the surface and cover it", "[surface]") {
     for (const Case& c : cases()) {
         double error[2] = {0, 0};
         int ni = 0;
@@ -174,8 +173,8 @@ TEST_CASE("surface: tessellation facets are planar, lie on the surface and cover
                 for (size_t k = 0; k < f.vertices.size(); ++k)
                     CHECK(length(f.vertices[k] - c.surface.point(f.uv[k].x, f.uv[k].y)) < 1e-12);
                 // Planar: the fourth corner lies in the plane of the first three.
-                Vec3 nf = normalize(cross(f.vertices[1] - f.vertices[0],
-                                          f.vertices[2] - f.vertices[0]));
+                Vec3 nf =
+                    normalize(cross(f.vertices[1] - f.vertices[0], f.vertices[2] - f.vertices[0]));
                 double size = length(f.vertices[2] - f.vertices[0]);
                 if (f.vertices.size() == 4)
                     CHECK(std::fabs(dot(f.vertices[3] - f.vertices[0], nf)) < 1e-12 * (1 + size));
