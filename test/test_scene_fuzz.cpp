@@ -6,7 +6,9 @@
 #include <unistd.h>
 
 #include <catch2/catch.hpp>
+#include <algorithm>
 #include <chrono>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -205,10 +207,20 @@ void check_scene(const Scene& s) {
     REQUIRE(s.settings.min_depth <= s.settings.max_depth);
 }
 
+/// Longer or different runs for hunting bugs by hand: MBR_FUZZ_ROUNDS multiplies the number of
+/// inputs, MBR_FUZZ_SEED is added to every seed. The defaults are what CTest runs.
+long env_number(const char* name, long def) {
+    const char* text = std::getenv(name);
+    return text ? std::strtol(text, nullptr, 10) : def;
+}
+
 /// Runs `parse` on `n` mutations of each seed text; counts accepted and refused inputs.
 template <class Parse>
 void fuzz(const std::vector<std::string>& seeds, int n, uint64_t seed, Parse parse, int& n_accepted,
           int& n_refused) {
+    seed += uint64_t(env_number("MBR_FUZZ_SEED", 0));
+    long rounds = std::max(1L, env_number("MBR_FUZZ_ROUNDS", 1));
+    n = int(std::min(long(n) * rounds, 100000000L));
     std::mt19937_64 rng(seed);
     for (int i = 0; i < n; ++i) {
         const std::string& base = seeds[size_t(i) % seeds.size()];
