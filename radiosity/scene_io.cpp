@@ -298,14 +298,19 @@ double check_length(const Line& line, double x, const std::string& what, bool al
     return x;
 }
 
-/// Checks an angle range in degrees: bounded, not empty, spanning at most span_limit.
+/// Checks an angle range in degrees: bounded, increasing, spanning at most span_limit.
 void check_angle_range(const Line& line, double a0, double a1, const std::string& what,
                        double span_limit) {
     if (std::fabs(a0) > max_angle_degrees || std::fabs(a1) > max_angle_degrees)
         line.fail(what + " angles must lie within +-" + fmt(max_angle_degrees) + " degrees");
     if (!(std::fabs(a1 - a0) >= 1e-6))
         line.fail(what + " range " + fmt(a0) + " .. " + fmt(a1) + " is empty (or below 1e-6)");
-    if (std::fabs(a1 - a0) > span_limit + 1e-9)
+    // A decreasing range would turn the surface around (x_u x x_v changes sign); the format
+    // keeps one way to say that: `inward`, or the disk's normal.
+    if (a1 < a0)
+        line.fail(what + " range " + fmt(a0) + " .. " + fmt(a1) +
+                  " must increase (turn a surface around with 'inward' or the disk's normal)");
+    if (a1 - a0 > span_limit + 1e-9)
         line.fail(what + " range " + fmt(a0) + " .. " + fmt(a1) + " spans more than " +
                   fmt(span_limit) + " degrees");
 }

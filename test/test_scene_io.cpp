@@ -293,6 +293,10 @@ TEST_CASE("scene_io: degenerate quads", "[scene_io][errors]") {
                 "theta range 30 .. 30 is empty");
     check_error(white + "cylinder c white 0 0 0  0 0 1  0 0 2  1 1  0 360\n", 2,
                 "is parallel to the axis");
+    check_error(white + "cylinder c white 0 0 0  0 0 1  1 0 0  1 1  90 -45\n", 2,
+                "phi range 90 .. -45 must increase");
+    check_error(white + "disk d white 0 0 0  0 0 1  1 0 0  0 1  0 400\n", 2,
+                "phi range 0 .. 400 spans more than 360 degrees");
 }
 
 TEST_CASE("scene_io: non-planar quad", "[scene_io][errors]") {
