@@ -15,6 +15,7 @@ namespace mbr {
 /// A field of RGB values over (u,v) in [0,1]^2. Copies are cheap (image texels are shared).
 class Texture {
 public:
+    /// The three kinds of field.
     enum class Kind { Constant, Checker, Image };
 
     /// Constant black (no reflection, no emission).
@@ -36,6 +37,7 @@ public:
     /// Largest image accepted (pixels), a guard against absurd headers and memory exhaustion.
     static constexpr long max_image_pixels = 1L << 25;
 
+    /// Which of the three kinds this is.
     Kind kind() const { return kind_; }
     /// The value at (u,v); arguments outside [0,1] are clamped to it (NaN reads as 0).
     Rgb value(double u, double v) const;
@@ -44,9 +46,10 @@ public:
     /// The mean over [0,1]^2 (exact for all three kinds: a bilinear image with clamped edges
     /// integrates to the average of its texels).
     Rgb mean() const;
-    /// Per-channel minimum and maximum over [0,1]^2 (exact: bilinear lookups stay within the
-    /// range of the texels they blend).
+    /// Per-channel minimum over [0,1]^2 (exact: bilinear lookups stay within the range of the
+    /// texels they blend).
     Rgb minimum() const;
+    /// Per-channel maximum over [0,1]^2 (exact, as minimum()).
     Rgb maximum() const;
     /// Where an image came from (empty for the procedural kinds).
     const std::string& source() const { return source_; }
