@@ -260,7 +260,7 @@ TEST_CASE("scene_io: NaN and infinity", "[scene_io][errors]") {
                 "coordinate 1e+300 exceeds the limit 1e+08");
 }
 
-TEST_CASE("scene_io: reflectance outside [0, 1)", "[scene_io][errors]") {
+TEST_CASE("scene_io: reflectance out of range", "[scene_io][errors]") {
     check_error("material m reflectance 0.5 1.2 0.5\n", 1, "reflectance 1.2 is outside [0, 1)");
     check_error("material m reflectance 1 1 1\n", 1, "reflectance 1 is outside [0, 1)");
     check_error("material m reflectance -0.1 0 0\n", 1, "reflectance -0.1 is outside [0, 1)");
