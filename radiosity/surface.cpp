@@ -1,6 +1,7 @@
 // radiosity/surface.cpp - the five surface kinds of DESIGN.md section 5.
 #include "radiosity/surface.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "math/check.h"
@@ -279,13 +280,18 @@ std::vector<Facet> Surface::tessellate(int resolution) const {
         facets.push_back({{p_[0], p_[1], p_[2], p_[3]}, {{0, 0}, {1, 0}, {1, 1}, {0, 1}}});
         return facets;
     }
-    const int n = resolution;
-    for (int i = 0; i < n; ++i)
-        for (int j = 0; j < n; ++j) {
-            Vec2 q[4] = {{double(i) / n, double(j) / n},
-                         {double(i + 1) / n, double(j) / n},
-                         {double(i + 1) / n, double(j + 1) / n},
-                         {double(i) / n, double(j + 1) / n}};
+    // An angular direction gets at least three facets: with one or two, a whole turn collapses
+    // to a line or a doubled flat strip (a whole cylinder at resolution 1 had no facets at all).
+    const bool angular_u = kind_ == Kind::Cylinder || kind_ == Kind::Sphere;
+    const bool angular_v = kind_ == Kind::Sphere || kind_ == Kind::Disk;
+    const int n_u = angular_u ? std::max(resolution, 3) : resolution;
+    const int n_v = angular_v ? std::max(resolution, 3) : resolution;
+    for (int i = 0; i < n_u; ++i)
+        for (int j = 0; j < n_v; ++j) {
+            Vec2 q[4] = {{double(i) / n_u, double(j) / n_v},
+                         {double(i + 1) / n_u, double(j) / n_v},
+                         {double(i + 1) / n_u, double(j + 1) / n_v},
+                         {double(i) / n_u, double(j + 1) / n_v}};
             Vec3 x[4];
             for (int c = 0; c < 4; ++c) x[c] = point(q[c].x, q[c].y);
             if (kind_ == Kind::BilinearPatch) {

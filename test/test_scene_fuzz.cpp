@@ -1,0 +1,318 @@
+// test/test_scene_fuzz.cpp - the scene and OBJ/MTL readers never crash or hang (issue 3): thousands
+// of randomly mutated inputs (byte flips, insertions, deletions, duplicated and swapped lines,
+// numbers replaced by huge, tiny, NaN or negative values, truncation), seeded and reproducible.
+// Every outcome must be a valid Scene or an InputError; anything else, or one input taking
+// more than a second, fails with the seed and the iteration so the case can be replayed.
+#include <unistd.h>
+
+#include <catch2/catch.hpp>
+#include <algorithm>
+#include <chrono>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <sstream>
+
+#include "math/check.h"
+#include "radiosity/scene_io.h"
+
+using namespace mbr;
+
+namespace {
+
+const std::string scenes_dir = std::string(MBR_SOURCE_DIR) + "/examples/scenes/";
+
+std::string read_file(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    std::ostringstream os;
+    os << in.rdbuf();
+    return os.str();
+}
+
+/// A scene that uses every statement, so mutations reach every branch of the reader.
+const std::string every_statement =
+    "material plain reflectance 0.2 0.3 0.4\n"
+    "material chk reflectance checker 3 0.1 0.1 0.1 0.7 0.7 0.7 emission 0 0 0\n"
+    "material img reflectance image picture.png emission image picture.png scale 2 2 2\n"
+    "material lamp emission 5 5 5   # a comment\n"
+    "quad q plain 0 0 0  1 0 0  1 1 0  0 1 0\n"
+    "bilinear b plain 0 0 0  1 0 0  1 1 1  0 1 0\n"
+    "rectangle r chk 0 0 2  1 0 0  0 1 0\n"
+    "box x img 0 0 3  1 1 4\n"
+    "cylinder c plain 0 0 0  0 0 1  1 0 0  0.5 2  0 180 inward\n"
+    "sphere s lamp 3 3 3  0 0 1  1 0 0  0.5  0 180  0 360\n"
+    "disk d plain 0 0 0  0 0 1  1 0 0  0 1  0 360\n"
+    "include parallel_squares.scene\n"
+    "camera eye 0 -10 0 look_at 0 0 0 up 0 0 1 fov 60 size 320 200\n"
+    "set order 3\nset min_depth 2\nset max_depth 5\nset oracle_tolerance 1e-4\n"
+    "set truncation_eps 1e-7\nset rhombus_radius 20\nset extrapolation higher\n"
+    "set shadow_rays 8\nset convergence 0.01\nset self_transfer true\n"
+    "set tessellation 8\n";
+
+/// An OBJ with every face form, negative indices, groups and polygons to split.
+const std::string obj_sample =
+    "mtllib cornell_box.mtl\n"
+    "v 0 0 0\nv 2 0 0\nv 2 1 0\nv 0 1 0\nv 1 2 0.3\nv -1 1 0\nvt 0 0\nvt 1 1\nvn 0 0 1\n"
+    "o thing\ng part\nusemtl white\ns 1\n"
+    "f 1 2 3 4\nf 1/1 2/2 3/1\nf 1//1 2//1 3//1 5//1 6//1\nf -6/-2/-1 -5/-1/-1 -4/-2/-1\n"
+    "usemtl light\nf 1 2 5 4\nf 1 2 3 5 6\ng\nf 4 3 2 1\n";
+
+const char* const dictionary[] = {"nan",
+                                  "inf",
+                                  "-inf",
+                                  "1e400",
+                                  "1e308",
+                                  "-1e308",
+                                  "1e-320",
+                                  "0",
+                                  "-0",
+                                  "-1",
+                                  "1",
+                                  "0.999",
+                                  "99999999999999999999",
+                                  "2147483648",
+                                  "#",
+                                  "\n",
+                                  " ",
+                                  "/",
+                                  "//",
+                                  "-",
+                                  ".",
+                                  "e",
+                                  "include",
+                                  "obj",
+                                  "quad",
+                                  "material",
+                                  "set",
+                                  "camera",
+                                  "inward",
+                                  "image",
+                                  "checker",
+                                  "f",
+                                  "v",
+                                  "usemtl",
+                                  "mtllib",
+                                  "newmtl",
+                                  "Kd",
+                                  "Ke",
+                                  "map_Kd",
+                                  "picture.png",
+                                  "nothere.png",
+                                  "\t",
+                                  "\r",
+                                  std::string("\0", 1).c_str(),
+                                  "\xff\xfe",
+                                  "\x89PNG",
+                                  "reflectance",
+                                  "emission",
+                                  "1e8",
+                                  "360",
+                                  "180",
+                                  "-360"};
+
+/// Returns a mutated copy of `text`: one to four random edits.
+std::string mutate(std::string text, std::mt19937_64& rng) {
+    auto pick = [&](size_t n) { return n == 0 ? size_t(0) : size_t(rng() % n); };
+    auto lines_of = [](const std::string& t) {
+        std::vector<std::string> lines;
+        std::string line;
+        std::istringstream in(t);
+        while (std::getline(in, line)) lines.push_back(line);
+        return lines;
+    };
+    auto join = [](const std::vector<std::string>& lines) {
+        std::string t;
+        for (const std::string& l : lines) t += l + "\n";
+        return t;
+    };
+    int n_edits = 1 + int(rng() % 4);
+    for (int e = 0; e < n_edits; ++e) {
+        switch (rng() % 9) {
+            case 0:  // flip bits of a byte
+                if (!text.empty()) text[pick(text.size())] ^= char(1 + rng() % 255);
+                break;
+            case 1: {  // insert random bytes
+                std::string bytes;
+                for (size_t n = 1 + pick(8); n > 0; --n) bytes += char(rng() % 256);
+                text.insert(pick(text.size() + 1), bytes);
+                break;
+            }
+            case 2:  // insert a token that matters to the readers
+                text.insert(pick(text.size() + 1),
+                            std::string(dictionary[pick(std::size(dictionary))]) + " ");
+                break;
+            case 3:  // delete a range
+                if (!text.empty()) text.erase(pick(text.size()), 1 + pick(16));
+                break;
+            case 4: {  // duplicate a line
+                auto lines = lines_of(text);
+                if (!lines.empty()) {
+                    size_t i = pick(lines.size());
+                    lines.insert(lines.begin() + long(pick(lines.size() + 1)), lines[i]);
+                }
+                text = join(lines);
+                break;
+            }
+            case 5: {  // swap two lines
+                auto lines = lines_of(text);
+                if (lines.size() >= 2)
+                    std::swap(lines[pick(lines.size())], lines[pick(lines.size())]);
+                text = join(lines);
+                break;
+            }
+            case 6:
+            case 7: {  // replace a number by a nasty one
+                std::vector<size_t> starts;
+                for (size_t i = 0; i < text.size(); ++i)
+                    if ((std::isdigit(static_cast<unsigned char>(text[i])) || text[i] == '-') &&
+                        (i == 0 || text[i - 1] == ' ' || text[i - 1] == '/'))
+                        starts.push_back(i);
+                if (starts.empty()) break;
+                size_t s = starts[pick(starts.size())], end = s;
+                while (end < text.size() && text[end] != ' ' && text[end] != '\n' &&
+                       text[end] != '/')
+                    ++end;
+                static const char* const nasty[] = {
+                    "nan",    "inf", "1e400", "1e300", "-1e300",      "-1",        "0",
+                    "1e-300", "1",   "7",     "-7",    "99999999999", "1.0000001", "0.99999999"};
+                text.replace(s, end - s, nasty[pick(std::size(nasty))]);
+                break;
+            }
+            case 8:  // truncate
+                text.resize(pick(text.size() + 1));
+                break;
+        }
+    }
+    return text;
+}
+
+/// What the readers promise about every scene they return.
+void check_scene(const Scene& s) {
+    REQUIRE(!s.surfaces.empty());
+    for (const SceneSurface& x : s.surfaces) {
+        REQUIRE(x.material >= 0);
+        REQUIRE(size_t(x.material) < s.materials.size());
+        double a = x.surface.area();
+        REQUIRE(std::isfinite(a));
+        REQUIRE(a > 0);
+    }
+    for (const Material& m : s.materials) {
+        for (int c = 0; c < 3; ++c) {
+            REQUIRE(m.reflectance.minimum()[c] >= 0);
+            REQUIRE(m.reflectance.maximum()[c] < 1);
+            REQUIRE(m.emission.minimum()[c] >= 0);
+        }
+    }
+    REQUIRE(s.settings.min_depth <= s.settings.max_depth);
+}
+
+/// Longer or different runs for hunting bugs by hand: MBR_FUZZ_ROUNDS multiplies the number of
+/// inputs, MBR_FUZZ_SEED is added to every seed. The defaults are what CTest runs.
+long env_number(const char* name, long def) {
+    const char* text = std::getenv(name);
+    return text ? std::strtol(text, nullptr, 10) : def;
+}
+
+/// Runs `parse` on `n` mutations of each seed text; counts accepted and refused inputs.
+template <class Parse>
+void fuzz(const std::vector<std::string>& seeds, int n, uint64_t seed, Parse parse, int& n_accepted,
+          int& n_refused) {
+    seed += uint64_t(env_number("MBR_FUZZ_SEED", 0));
+    long rounds = std::max(1L, env_number("MBR_FUZZ_ROUNDS", 1));
+    n = int(std::min(long(n) * rounds, 100000000L));
+    std::mt19937_64 rng(seed);
+    for (int i = 0; i < n; ++i) {
+        const std::string& base = seeds[size_t(i) % seeds.size()];
+        std::string text = mutate(base, rng);
+        auto start = std::chrono::steady_clock::now();
+        try {
+            Scene s = parse(text);
+            check_scene(s);
+            ++n_accepted;
+        } catch (const InputError& e) {
+            CHECK(!e.message().empty());
+            ++n_refused;
+        } catch (const std::exception& e) {
+            FAIL("seed " << seed << ", iteration " << i << ": not an InputError: " << e.what()
+                         << "\n--- input ---\n"
+                         << text);
+        }
+        double seconds =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        if (seconds > 1.0)
+            FAIL("seed " << seed << ", iteration " << i << " took " << seconds
+                         << " s\n--- input ---\n"
+                         << text);
+    }
+}
+
+}  // namespace
+
+TEST_CASE("scene_fuzz: mutated scene files give a Scene or an InputError", "[scene_fuzz]") {
+    std::vector<std::string> seeds = {every_statement};
+    for (const char* f : {"parallel_squares.scene", "perpendicular_squares.scene",
+                          "three_strips.scene", "room.scene", "cornell_box.scene"})
+        seeds.push_back(read_file(scenes_dir + f));
+    for (const std::string& s : seeds) REQUIRE(!s.empty());
+    int n_accepted = 0, n_refused = 0;
+    const uint64_t seed = 20240601;
+    fuzz(
+        seeds, 6000, seed,
+        [](const std::string& text) {
+            std::istringstream in(text);
+            return parse_scene(in, scenes_dir + "fuzz.scene");
+        },
+        n_accepted, n_refused);
+    CAPTURE(n_accepted, n_refused);
+    // Both outcomes must be common, or the mutations are too mild or too wild to test much.
+    CHECK(n_accepted > 300);
+    CHECK(n_refused > 3000);
+}
+
+TEST_CASE("scene_fuzz: mutated OBJ files give a Scene or an InputError", "[scene_fuzz][obj]") {
+    std::vector<std::string> seeds = {obj_sample, read_file(scenes_dir + "cornell_box.obj")};
+    int n_accepted = 0, n_refused = 0;
+    fuzz(
+        seeds, 3000, 77,
+        [](const std::string& text) {
+            std::istringstream in(text);
+            return parse_obj(in, scenes_dir + "fuzz.obj");
+        },
+        n_accepted, n_refused);
+    CAPTURE(n_accepted, n_refused);
+    CHECK(n_accepted > 300);
+    CHECK(n_refused > 1000);
+}
+
+TEST_CASE("scene_fuzz: mutated MTL files give a Scene or an InputError", "[scene_fuzz][obj]") {
+    // MTL files are read from disk only: mutations go to a scratch folder with a copy of the
+    // texture they may name.
+    std::filesystem::path dir = std::filesystem::temp_directory_path() /
+                                ("mbr_test_scene_fuzz_" + std::to_string(long(getpid())));
+    std::filesystem::create_directories(dir);
+    std::filesystem::copy_file(scenes_dir + "picture.png", dir / "picture.png",
+                               std::filesystem::copy_options::overwrite_existing);
+    const std::string mtl_seed = read_file(scenes_dir + "cornell_box.mtl") +
+                                 "newmtl tex\nKa 0.1 0.1 0.1\nKd 0.5 0.5 0.5\nmap_Kd -s 1 1 1 "
+                                 "picture.png\nKe 0.1 0.1 0.1\nmap_Ke picture.png\nNs 10\nd 1\n"
+                                 "illum 2\n";
+    const std::string obj =
+        "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nusemtl white\n"
+        "f 1 2 3 4\nusemtl light\nf 4 3 2 1\n";
+    const std::string obj_path = (dir / "m.obj").string();
+    std::ofstream(obj_path, std::ios::binary) << obj;
+    int n_accepted = 0, n_refused = 0;
+    fuzz(
+        {mtl_seed}, 800, 99,
+        [&](const std::string& text) {
+            std::ofstream((dir / "m.mtl").string(), std::ios::binary | std::ios::trunc) << text;
+            return load_obj(obj_path);
+        },
+        n_accepted, n_refused);
+    std::error_code ec;
+    std::filesystem::remove_all(dir, ec);
+    CAPTURE(n_accepted, n_refused);
+    CHECK(n_accepted > 50);
+    CHECK(n_refused > 200);
+}
