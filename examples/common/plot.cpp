@@ -603,12 +603,13 @@ PlotLayout Plot::draw(Image& image, const PixelRect& panel) const {
                 {&ser.stroke, ser.marker, ser.marker_radius, ser.draw_line, &ser.label});
     for (const VLine& v : vlines_)
         if (!v.label.empty()) entries.push_back({&v.stroke, Marker::none, 0, true, &v.label});
-    if (legend != LegendPlace::none && !entries.empty()) {
-        const int sample = 5 * glyph_advance * s;  // length of the sample line
-        int widest = 0;
-        for (const Entry& e : entries) widest = std::max(widest, text_width(*e.label, s));
-        const int w = gap + sample + gap + widest + gap;
-        const int h = gap + int(entries.size()) * line + gap / 2;
+    const int sample = 5 * glyph_advance * s;  // length of the legend's sample lines
+    int widest = 0;
+    for (const Entry& e : entries) widest = std::max(widest, text_width(*e.label, s));
+    const int w = gap + sample + gap + widest + gap;
+    const int h = gap + int(entries.size()) * line + gap / 2;
+    // A legend that would hide much of a small plot is left out.
+    if (legend != LegendPlace::none && !entries.empty() && 4 * w <= 3 * a.w && 2 * h <= a.h) {
         auto corner_box = [&](LegendPlace place) {
             const bool left = place == LegendPlace::top_left || place == LegendPlace::bottom_left;
             const bool upper = place == LegendPlace::top_left || place == LegendPlace::top_right;

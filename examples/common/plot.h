@@ -135,6 +135,7 @@ struct Series {
 
 /// Where the legend box goes inside the plot area; `best` takes the corner whose box covers
 /// the least of the drawn data (ties in the order top right, top left, bottom right, bottom left).
+/// A legend wider than 3/4 or taller than 1/2 of the plot area is not drawn.
 enum class LegendPlace { none, best, top_left, top_right, bottom_left, bottom_right };
 
 /// Where a plot's data went on the image: the plot area, the data ranges, the ticks.
