@@ -357,7 +357,10 @@ std::string tick_label(double value, double step) {
     if (magnitude >= 1e6 || step < 1e-4) {
         std::snprintf(buf, sizeof buf, "%g", value);
     } else {
-        const int decimals = std::max(0, static_cast<int>(std::ceil(-std::log10(step) - 1e-9)));
+        // The fewest decimals that write the step exactly (0.5 -> 1, 0.25 -> 2, 20 -> 0).
+        int decimals = 0;
+        for (double scaled = step; decimals < 12; ++decimals, scaled *= 10)
+            if (std::fabs(scaled - std::round(scaled)) < 1e-9 * scaled) break;
         std::snprintf(buf, sizeof buf, "%.*f", decimals, value);
     }
     return buf;
