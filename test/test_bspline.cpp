@@ -5,7 +5,6 @@
 // integrals on the unit knot intervals (exact for polynomials), and direct sums
 // sum_k a_k N_m(2^j s - k) written out here rather than through evaluate().
 #include <catch2/catch.hpp>
-
 #include <cmath>
 #include <random>
 #include <vector>
@@ -27,7 +26,8 @@ double truncated_power_bspline(int m, double x_in) {
     for (int k = 2; k < m; ++k) fact *= k;
     for (int i = 0; i <= m; ++i) {
         const long double d = x - i;
-        if (d >= 0) sum += ((i % 2) ? -binom : binom) * std::pow(d, static_cast<long double>(m - 1));
+        if (d >= 0)
+            sum += ((i % 2) ? -binom : binom) * std::pow(d, static_cast<long double>(m - 1));
         binom = binom * (m - i) / (i + 1);
     }
     return static_cast<double>(sum / fact);
@@ -78,7 +78,7 @@ TEST_CASE("bspline: integer translates sum to one", "[bspline]") {
         }
 }
 
-TEST_CASE("bspline: non-negative, symmetric about m/2, zero outside [0, m)", "[bspline]") {
+TEST_CASE("bspline: non-negative, symmetric about m/2, zero outside its support", "[bspline]") {
     const unsigned seed = 102;
     CAPTURE(seed);
     std::mt19937 rng(seed);
@@ -135,7 +135,10 @@ TEST_CASE("bspline: known values N_m(k) and omega_{m,k}", "[bspline]") {
     CHECK(bspline(2, 1.0) == 1.0);
     CHECK(bspline(3, 1.5) == Approx(0.75).epsilon(1e-15));
     const std::vector<std::vector<double>> omega_expected = {
-        {1, 0}, {0, 1, 0}, {0, 0.5, 0.5, 0}, {0, 1.0 / 6, 4.0 / 6, 1.0 / 6, 0},
+        {1, 0},
+        {0, 1, 0},
+        {0, 0.5, 0.5, 0},
+        {0, 1.0 / 6, 4.0 / 6, 1.0 / 6, 0},
         {0, 1.0 / 24, 11.0 / 24, 11.0 / 24, 1.0 / 24, 0}};
     for (int m = 1; m <= 5; ++m) {
         CAPTURE(m);
@@ -190,8 +193,9 @@ TEST_CASE("bspline: derivatives agree with finite differences", "[bspline]") {
                 // derivative is discontinuous at knots for r = m - 1).
                 if (std::fabs(x - std::round(x)) < 2 * h) continue;
                 CAPTURE(m, r, x);
-                const double fd = (bspline_derivative(m, r - 1, x + h) -
-                                   bspline_derivative(m, r - 1, x - h)) / (2 * h);
+                const double fd =
+                    (bspline_derivative(m, r - 1, x + h) - bspline_derivative(m, r - 1, x - h)) /
+                    (2 * h);
                 // Central difference of a polynomial piece: error h^2/6 max|N_m^{(r+2)}| with
                 // |N_m^{(q)}| <= 2^q, so <= 1e-8 * 128 / 6 ~ 2e-7; rounding 2^r eps / h ~ 4e-11.
                 CHECK(bspline_derivative(m, r, x) == Approx(fd).margin(3e-7));
@@ -306,7 +310,7 @@ TEST_CASE("bspline: refinement (17) of a single coefficient is the mask", "[bspl
     }
 }
 
-TEST_CASE("bspline: touching layout covers exactly the basis functions meeting [0, 1]",
+TEST_CASE("bspline: touching layout covers exactly the basis functions meeting the unit interval",
           "[bspline]") {
     for (int m = 1; m <= 5; ++m)
         for (int level = 0; level <= 4; ++level) {
@@ -337,7 +341,7 @@ TEST_CASE("bspline: touching layout covers exactly the basis functions meeting [
         }
 }
 
-TEST_CASE("bspline: refine_touching keeps the function on [0, 1] in 1D", "[bspline]") {
+TEST_CASE("bspline: refine_touching keeps the function on the unit interval", "[bspline]") {
     const unsigned seed = 109;
     CAPTURE(seed);
     std::mt19937 rng(seed);
@@ -436,7 +440,8 @@ TEST_CASE("bspline: dyadic evaluation (18) equals direct evaluation", "[bspline]
                     CAPTURE(i);
                     // Both sides are sums of <= m products with |a| <= 1 and weights forming a
                     // partition of unity, after <= 3 refinements: a few ulps. 1e-14.
-                    CHECK(values[idx] == Approx(direct_sum(m, row, std::ldexp(i, -j1))).margin(1e-14));
+                    CHECK(values[idx] ==
+                          Approx(direct_sum(m, row, std::ldexp(i, -j1))).margin(1e-14));
                 }
                 // Every dyadic point where f can be non-zero is included: just outside, f = 0.
                 CHECK(direct_sum(m, row, std::ldexp(first_i - 1, -j1)) == 0);

@@ -6,17 +6,16 @@
 // here is a polynomial of degree <= 2m - 2 between integer knots); the closed form for m = 2;
 // the decay rate from the roots of the Gram symbol (Euler-Frobenius polynomial); dense sampling
 // of the table for the radii.
-#include <catch2/catch.hpp>
-
 #include <algorithm>
+#include <catch2/catch.hpp>
 #include <cmath>
-#include <iostream>
 #include <random>
 #include <vector>
 
 #include "math/bspline.h"
 #include "math/dual_basis.h"
 #include "math/gauss_legendre.h"
+#include "test/report.h"
 
 using namespace mbr;
 
@@ -32,7 +31,9 @@ double integrate_pieces(F&& f, int a, int b, const GaussLegendre& rule) {
 }
 
 /// mu_{m;0,l} far beyond any table (l = 0..150), the reference for truncation errors.
-std::vector<double> long_mu(int m) { return dual_coefficients(m, 150, 1e-17).mu; }
+std::vector<double> long_mu(int m) {
+    return dual_coefficients(m, 150, 1e-17).mu;
+}
 
 /// Root of the Gram symbol sum_n gamma_|n| z^n in (-1, 0) closest to -1 (the Euler-Frobenius
 /// polynomial has only simple negative roots), by a scan and bisection.
@@ -52,7 +53,10 @@ double dominant_root(const std::vector<double>& gamma) {
             double a = z_prev, b = z;
             for (int it = 0; it < 200; ++it) {
                 const double c = 0.5 * (a + b);
-                if ((symbol(c) > 0) == (symbol(a) > 0)) a = c; else b = c;
+                if ((symbol(c) > 0) == (symbol(a) > 0))
+                    a = c;
+                else
+                    b = c;
             }
             return 0.5 * (a + b);
         }
@@ -76,7 +80,7 @@ TEST_CASE("dual: Gram sequence equals <N_m, N_m(. - n)> by quadrature", "[dual]"
             const double q = integrate_pieces(
                 [&](double x) { return bspline(m, x) * bspline(m, x - n); }, 0, m + n, rule);
             const double g = n < m ? gamma[n] : 0.0;  // gamma_n = 0 for |n| >= m
-            CHECK(g == Approx(q).margin(1e-15));       // both exact up to rounding of values < 1
+            CHECK(g == Approx(q).margin(1e-15));      // both exact up to rounding of values < 1
             total += (n == 0 ? 1 : 2) * g;
         }
         // sum_n gamma_n = <N_m, sum_n N_m(. - n)> = int N_m = 1.
@@ -84,7 +88,7 @@ TEST_CASE("dual: Gram sequence equals <N_m, N_m(. - n)> by quadrature", "[dual]"
     }
 }
 
-TEST_CASE("dual: mu_{3;0,l} equals the paper's Table 3 at six decimals", "[dual][paper]") {
+TEST_CASE("dual: mu for m = 3 equals the paper's Table 3 at six decimals", "[dual][paper]") {
     constexpr double paper_mu3[19] = {2.842171,  -1.321729, 0.573326,  -0.247042, 0.106378,
                                       -0.045804, 0.019722,  -0.008492, 0.003656,  -0.001574,
                                       0.000678,  -0.000292, 0.000126,  -0.000054, 0.000023,
@@ -137,15 +141,16 @@ TEST_CASE("dual: m = 2 has the closed form mu_l = sqrt(3) (sqrt(3) - 2)^|l|", "[
     for (size_t l = 0; l < table.mu().size(); ++l) {
         CAPTURE(l);
         // Relative accuracy of the solve ~1e-16 near the centre, absolute ~1e-16 in the tail.
-        CHECK(table.mu()[l] == Approx(std::sqrt(3.0) * std::pow(z, double(l))).epsilon(1e-13).margin(1e-16));
+        CHECK(table.mu()[l] ==
+              Approx(std::sqrt(3.0) * std::pow(z, double(l))).epsilon(1e-13).margin(1e-16));
     }
 }
 
 TEST_CASE("dual: mu_l decays at the rate of the Gram symbol's dominant root", "[dual]") {
     // mu_l ~ C lambda^|l| where lambda is the root of the Euler-Frobenius polynomial in (-1, 0)
     // nearest -1; DESIGN.md quotes 0.535 per cell for m = 4.
-    const double expected_lambda[] = {0, 0, std::sqrt(3.0) - 2, -0.4305753471, -0.5352804308,
-                                      -0.6079973892};
+    const double expected_lambda[] = {
+        0, 0, std::sqrt(3.0) - 2, -0.4305753471, -0.5352804308, -0.6079973892};
     for (int m = 2; m <= 5; ++m) {
         CAPTURE(m);
         const double lambda = dominant_root(gram_sequence(m));
@@ -174,7 +179,8 @@ TEST_CASE("dual: DualTable agrees with the direct sum (32) within error_bound()"
             CHECK(table.error_bound() >= 0);
             CHECK(table.error_bound() <= 2 * tail_eps * mu_long[0]);
             const double H = table.half_width();
-            std::uniform_real_distribution<double> u(table.fulcrum() - H - 1, table.fulcrum() + H + 1);
+            std::uniform_real_distribution<double> u(table.fulcrum() - H - 1,
+                                                     table.fulcrum() + H + 1);
             double worst = 0;
             for (int trial = 0; trial < 400; ++trial) {
                 const double x = (trial < 40) ? std::round(u(rng)) : u(rng);  // knots too
@@ -194,10 +200,10 @@ TEST_CASE("dual: DualTable agrees with the direct sum (32) within error_bound()"
                 CHECK(std::fabs(dual_basis(m, mu_long, table.fulcrum() + dx)) <=
                       table.error_bound() + 1e-16);
             }
-            std::cout << "dual: m = " << m << ", tail_eps = " << tail_eps << ": "
-                      << table.mu().size() - 1 << " coefficients, half width " << H
-                      << ", error_bound " << table.error_bound() << ", worst table error " << worst
-                      << '\n';
+            mbr::test::report() << "dual: m = " << m << ", tail_eps = " << tail_eps << ": "
+                                << table.mu().size() - 1 << " coefficients, half width " << H
+                                << ", error_bound " << table.error_bound() << ", worst table error "
+                                << worst << '\n';
         }
 }
 
@@ -243,7 +249,8 @@ TEST_CASE("dual: biorthogonality <N_m(. - k), DN_m(. - l)> = delta_kl", "[dual]"
             // of m^2 products of size <= 3: 4e-15.
             CHECK(ip == Approx(k == 0 ? 1.0 : 0.0).margin(table.error_bound() + 4e-15));
         }
-        std::cout << "dual: m = " << m << ", worst biorthogonality error " << worst << '\n';
+        mbr::test::report() << "dual: m = " << m << ", worst biorthogonality error " << worst
+                            << '\n';
     }
 }
 
@@ -332,8 +339,9 @@ TEST_CASE("dual: projection onto V_0 by (13) reproduces polynomials of degree < 
             // 2.3e-16), and c_k weights mu_l by about |f| at distance |l|, up to (H + m + 2)^p:
             // sum over |l| <= H + m + 2 gives 2 (H + m + 2)^{p+1} / (p + 1). Measured 10..1000
             // times below this bound (1.9e-8 for m = 5, degree 4).
-            const double tol = (table.error_bound() + 2.3e-16) * 2 *
-                                   std::pow(H + m + 2.0, p + 1) / (p + 1) + 1e-14;
+            const double tol =
+                (table.error_bound() + 2.3e-16) * 2 * std::pow(H + m + 2.0, p + 1) / (p + 1) +
+                1e-14;
             double worst = 0;
             for (double x : {0.0, 0.4, 1.7, 2.0, 3.3, 4.99}) {
                 double sum = 0;
@@ -342,8 +350,8 @@ TEST_CASE("dual: projection onto V_0 by (13) reproduces polynomials of degree < 
                 CHECK(sum == Approx(f(x)).margin(tol));
                 worst = std::max(worst, std::fabs(sum - f(x)));
             }
-            std::cout << "dual: m = " << m << ", degree " << p << ": reproduction error "
-                      << worst << " (tolerance " << tol << ")\n";
+            mbr::test::report() << "dual: m = " << m << ", degree " << p << ": reproduction error "
+                                << worst << " (tolerance " << tol << ")\n";
         }
     }
 }
@@ -402,7 +410,10 @@ TEST_CASE("dual: rhombus_radius contains every point where |DN DN| > eps max^2",
                 int lo = 0, hi = n;  // largest j with suffix_max[j] > need
                 while (lo < hi) {
                     const int mid = (lo + hi + 1) / 2;
-                    if (suffix_max[mid] > need) lo = mid; else hi = mid - 1;
+                    if (suffix_max[mid] > need)
+                        lo = mid;
+                    else
+                        hi = mid - 1;
                 }
                 tightest = std::max(tightest, double(i + lo) / S);
             }
@@ -413,9 +424,9 @@ TEST_CASE("dual: rhombus_radius contains every point where |DN DN| > eps max^2",
             CHECK(r >= table.truncation_radius(eps) - 1.0 / 16);
             CHECK(r >= previous);  // smaller eps, larger rhombus
             previous = r;
-            std::cout << "dual: m = " << m << ", eps = " << eps << ": rhombus radius " << r
-                      << " (tightest sampled " << tightest << "), 1D radius "
-                      << table.truncation_radius(eps) << '\n';
+            mbr::test::report() << "dual: m = " << m << ", eps = " << eps << ": rhombus radius "
+                                << r << " (tightest sampled " << tightest << "), 1D radius "
+                                << table.truncation_radius(eps) << '\n';
         }
     }
 }

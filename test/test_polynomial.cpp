@@ -4,7 +4,6 @@
 // Reference: random tensor polynomials written out as explicit double sums, evaluated at the
 // nodes of the parent cell and of its sub-cells.
 #include <catch2/catch.hpp>
-
 #include <cmath>
 #include <random>
 #include <vector>
@@ -61,7 +60,8 @@ TEST_CASE("polynomial: TensorPolynomial evaluates sum c_ij x^i y^j", "[polynomia
     }
 }
 
-TEST_CASE("polynomial: fit_tensor_polynomial reproduces polynomials of degree < m", "[polynomial]") {
+TEST_CASE("polynomial: fit_tensor_polynomial reproduces polynomials of degree < m",
+          "[polynomial]") {
     const unsigned seed = 402;
     CAPTURE(seed);
     std::mt19937 rng(seed);
@@ -200,7 +200,7 @@ TEST_CASE("polynomial: resampling twice to level 1 equals resampling once to lev
         CAPTURE(m);
         const GaussLegendre rule = gauss_legendre(m);
         std::vector<double> samples(size_t(m) * m);  // arbitrary data: both are the same
-        for (double& s : samples) s = u(rng);         // interpolant, resampled
+        for (double& s : samples) s = u(rng);        // interpolant, resampled
         const std::vector<double> R10 = subcell_resample_matrix(rule, 1, 0);
         const std::vector<double> R11 = subcell_resample_matrix(rule, 1, 1);
         const std::vector<double> R21 = subcell_resample_matrix(rule, 2, 1);

@@ -7,7 +7,6 @@
 // (inner products by Gauss-Legendre, exact on the level-j cells); hence Pythagoras and a norm
 // that never grows.
 #include <catch2/catch.hpp>
-
 #include <cmath>
 #include <random>
 #include <vector>
@@ -69,7 +68,9 @@ double inner_product_2d(int m, int level, F&& f, G&& g) {
 /// is tiny (int_{m-1}^m N_m^2 = 1/((2m-1) ((m-1)!)^2): 1.9e-4 for m = 5) and the condition number
 /// grows to ~1e4 (m = 5). Measured worst over j = 1..8: 2e-15 (m <= 3), 1.7e-13 (m = 4),
 /// 3.2e-12 (m = 5), always in that first coefficient; the function values stay within 1e-13.
-double coefficient_margin(int m) { return m <= 3 ? 1e-14 : (m == 4 ? 1e-12 : 1e-11); }
+double coefficient_margin(int m) {
+    return m <= 3 ? 1e-14 : (m == 4 ? 1e-12 : 1e-11);
+}
 
 /// The coarse row on the fine row's level and layout, to subtract coefficient-wise.
 CoefficientRow difference(int m, const CoefficientRow& fine, const CoefficientRow& coarse) {
@@ -107,7 +108,7 @@ TEST_CASE("wavelet: coarsen returns a level-(j-1) function unchanged", "[wavelet
             }
 }
 
-TEST_CASE("wavelet: the residual f - coarsen(f) is orthogonal to level j-1 on [0, 1]",
+TEST_CASE("wavelet: the residual f - coarsen(f) is orthogonal to level j-1 on the unit interval",
           "[wavelet]") {
     const unsigned seed = 502;
     CAPTURE(seed);
@@ -218,7 +219,8 @@ TEST_CASE("wavelet: 2D coarsen is the tensor product of 1D coarsens", "[wavelet]
     for (int m = 1; m <= 5; ++m)
         for (int j = 1; j <= 4; ++j) {
             CAPTURE(m, j);
-            const CoefficientRow rs = random_touching_row(rng, m, j), rt = random_touching_row(rng, m, j);
+            const CoefficientRow rs = random_touching_row(rng, m, j),
+                                 rt = random_touching_row(rng, m, j);
             CoefficientGrid g = touching_grid(m, j);
             for (int k = rs.first; k <= rs.last(); ++k)
                 for (int l = rt.first; l <= rt.last(); ++l) g(k, l) = rs.at(k) * rt.at(l);
@@ -230,7 +232,7 @@ TEST_CASE("wavelet: 2D coarsen is the tensor product of 1D coarsens", "[wavelet]
         }
 }
 
-TEST_CASE("wavelet: 2D residual is orthogonal to level j-1 on [0, 1]^2 and the norm drops",
+TEST_CASE("wavelet: 2D residual is orthogonal to level j-1 on the unit square and the norm drops",
           "[wavelet]") {
     const unsigned seed = 506;
     CAPTURE(seed);
