@@ -199,14 +199,16 @@ std::vector<double> dyadic_values(int m, const CoefficientRow& row, int j1, int*
     CoefficientRow fine = row;
     while (fine.level < j1) fine = refine(m, fine);  // (17) applied recursively
     const std::vector<double> omega = integer_values(m);
-    // Eq. (18): f(i / 2^j1) = sum_l omega_{m, i-l} a_l, omega non-zero for i - l in 1..m-1.
-    const int first = fine.first + 1;
-    const int count = static_cast<int>(fine.a.size()) + m - 2;
+    // Eq. (18): f(i / 2^j1) = sum_l omega_{m, i-l} a_l, omega non-zero for i - l in d0..m-1:
+    // d0 = 1 for m >= 2 (N_m(0) = 0), but d0 = 0 for m = 1 (N_1 is the indicator of [0, 1)).
+    const int d0 = (m == 1) ? 0 : 1;
+    const int first = fine.first + d0;
+    const int count = static_cast<int>(fine.a.size()) + m - 1 - d0;
     std::vector<double> values(std::max(count, 0), 0.0);
     for (int idx = 0; idx < count; ++idx) {
         int i = first + idx;
         double sum = 0;
-        for (int d = 1; d <= m - 1; ++d) sum += omega[d] * fine.at(i - d);
+        for (int d = d0; d <= m - 1; ++d) sum += omega[d] * fine.at(i - d);
         values[idx] = sum;
     }
     if (first_i) *first_i = first;

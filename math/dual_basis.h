@@ -53,16 +53,16 @@ public:
     const std::vector<double>& mu() const { return mu_; }
     /// Half-width of the tabulated support, measured from the fulcrum.
     double half_width() const { return last_ - fulcrum() + 1; }
-    /// Largest |DN_m|, attained at the fulcrum: DN_m(m/2).
+    /// Largest |DN_m|, attained at the fulcrum (sampled there: exact up to rounding).
     double max_abs() const { return max_abs_; }
     /// Bound on |DN_m(x) - table(x)| for all x: the largest dropped |mu_l| plus the solve's
     /// convergence tolerance (the N_m(x - l) at any x sum to one).
     double error_bound() const { return error_bound_; }
-    /// Upper bound of |DN_m| over [a, b] (pieces sampled densely, plus a safety margin of
-    /// the sampling error); used by the truncation radii.
+    /// Upper bound of |DN_m| over [a, b] (pieces sampled densely, plus a bound on how far the
+    /// true maximum can exceed the samples, from |DN_m''|); used by the truncation radii.
     double max_abs_on(double a, double b) const;
 
-    /// 1D truncation radius for relative eps: the smallest R (a multiple of 1/8) such that
+    /// 1D truncation radius for relative eps: the smallest R (a multiple of 1/16) such that
     /// |DN_m(m/2 + x)| <= eps * max|DN_m| for all |x| >= R. In units of the basis scale.
     double truncation_radius(double eps) const;
     /// 2D rhombus radius (section 5 "Projection", Figure 3; DESIGN.md section 3 stage 6): an r
