@@ -51,42 +51,55 @@ IncrementIntegrator::IncrementIntegrator(const Shooter& shooter, const Quadratur
     : shooter_(shooter), options_(options) {
     MBR_CHECK(shooter.surface != nullptr && !shooter.unshot.empty());
     MBR_CHECK(options.n >= 1 && options.max_depth >= 0 && options.max_depth <= 28);
+    MBR_CHECK(options.n + 1 <= 64);
     unshot_bound_ = shooter.unshot.max_abs_coefficient();  // B-splines sum to one
+    unshot_constant_ = shooter.unshot.is_constant();
+    pool_.reserve(1 << 20);  // 72 MB per thread at most; then the cache starts over
+    unshot_values_.resize(size_t(options.n + 1) * (options.n + 1));
     rules_.resize(options.n + 2);
     for (int n = 1; n <= options.n + 1; ++n) rules_[n] = gauss_legendre(n);
 }
 
-const std::vector<ShooterPoint>& IncrementIntegrator::points(const QuadCell& cell, int n) {
+IncrementIntegrator::PointSpan IncrementIntegrator::points(const QuadCell& cell, int n) {
     // Key: level (5 bits), i and j (28 bits each: cells of [0,1]^2 have non-negative indices
     // below 2^level), and which of the two rules.
     const std::uint64_t key = (std::uint64_t(cell.level) << 57) | (std::uint64_t(cell.i) << 29) |
                               (std::uint64_t(cell.j) << 1) | std::uint64_t(n == options_.n ? 0 : 1);
     auto it = cache_.find(key);
-    if (it != cache_.end()) return it->second;
+    if (it != cache_.end()) return {pool_.data() + it->second, n * n};
     // Bound the cache (deep singular corners can make many cells); values never depend on it.
-    if (cached_points_ > 4000000) {
+    if (pool_.size() + size_t(n) * n > pool_.capacity()) {
         cache_.clear();
-        cached_points_ = 0;
+        pool_.clear();
     }
     const GaussLegendre& rule = rules_[n];
     const Rect& r = cell.rect;
     const double hx = 0.5 * r.width(), hy = 0.5 * r.height();
-    std::vector<ShooterPoint> pts;
-    pts.reserve(size_t(n) * n);
+    double u[64], v[64];
+    for (int a = 0; a < n; ++a) {
+        u[a] = r.x0 + hx * (rule.x[a] + 1);
+        v[a] = r.y0 + hy * (rule.x[a] + 1);
+    }
+    Rgb* B = unshot_values_.data();  // n*n values of B_h on the cell's tensor grid
+    if (unshot_constant_)
+        std::fill(B, B + n * n, shooter_.unshot.coefficient(0, 0));
+    else
+        shooter_.unshot.evaluate_grid(u, n, v, n, B);
+    const std::uint32_t offset = static_cast<std::uint32_t>(pool_.size());
     for (int a = 0; a < n; ++a)
         for (int b = 0; b < n; ++b) {
-            const double u = r.x0 + hx * (rule.x[a] + 1), v = r.y0 + hy * (rule.x[b] + 1);
-            const SurfacePoint sp = shooter_.surface->evaluate(u, v);
+            const SurfacePoint sp = shooter_.surface->evaluate(u[a], v[b]);
             const double w_J_A = rule.w[a] * rule.w[b] * hx * hy * sp.area_factor;
-            pts.push_back({sp.position, sp.normal, w_J_A * shooter_.unshot.evaluate(u, v)});
+            pool_.push_back({sp.position, sp.normal, w_J_A * B[a * n + b]});
         }
-    cached_points_ += pts.size();
-    return cache_.emplace(key, std::move(pts)).first->second;
+    cache_.emplace(key, offset);
+    return {pool_.data() + offset, n * n};
 }
 
-Rgb IncrementIntegrator::sum_over(const SurfacePoint& p, const std::vector<ShooterPoint>& pts) const {
+Rgb IncrementIntegrator::sum_over(const SurfacePoint& p, PointSpan pts) const {
     Rgb sum;
-    for (const ShooterPoint& q : pts) {
+    for (int i = 0; i < pts.count; ++i) {
+        const ShooterPoint& q = pts.first[i];
         const double F = form_factor_kernel(p.position, p.normal, q.x, q.n);  // eq. (3)
         if (F != 0) sum += F * q.e;
     }

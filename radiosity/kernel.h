@@ -41,8 +41,8 @@ struct Shooter {
 
 /// Options of the adaptive quadrature of (21) over the shooter (section 6).
 struct QuadratureOptions {
-    int n = 4;                    // compare n x n with (n+1) x (n+1) Gauss-Legendre points
-    double rel_tolerance = 1e-6;  // allowed error relative to a first estimate of the integral
+    int n = 6;                    // compare n x n with (n+1) x (n+1) Gauss-Legendre points
+    double rel_tolerance = 1e-4;  // allowed error relative to a first estimate of the integral
     int max_depth = 24;           // cap on the shooter's subdivision (at most 28)
     double min_share = 1e-6;      // floor of a cell's share of the tolerance (math/gauss_legendre.h)
 };
@@ -79,17 +79,24 @@ public:
     /// points are not swamped by it.
     Rgb integrate_on(const SurfacePoint& p, const std::vector<AcceptedCell<Rgb>>& partition,
                      long* n_evaluations);
-    /// The points of a cell for the n-point rule (cached).
-    const std::vector<ShooterPoint>& points(const QuadCell& cell, int n);
+    /// The points of a cell for the n-point rule (cached): n*n points from `first`, valid until
+    /// the next call.
+    struct PointSpan {
+        const ShooterPoint* first;
+        int count;
+    };
+    PointSpan points(const QuadCell& cell, int n);
 
 private:
-    Rgb sum_over(const SurfacePoint& p, const std::vector<ShooterPoint>& pts) const;
+    Rgb sum_over(const SurfacePoint& p, PointSpan pts) const;
     const Shooter& shooter_;
     QuadratureOptions options_;
     std::vector<GaussLegendre> rules_;  // rules_[n]
-    std::unordered_map<std::uint64_t, std::vector<ShooterPoint>> cache_;
-    size_t cached_points_ = 0;
-    double unshot_bound_ = 0;  // max |B_h| bound: the largest coefficient
+    std::vector<ShooterPoint> pool_;    // every cached cell's points, one after the other
+    std::vector<Rgb> unshot_values_;    // scratch: B_h on one cell's grid
+    std::unordered_map<std::uint64_t, std::uint32_t> cache_;  // cell key -> offset in pool_
+    double unshot_bound_ = 0;           // max |B_h| bound: the largest coefficient
+    bool unshot_constant_ = false;      // B_h is one constant (an emitter's first shot)
 };
 
 }  // namespace mbr

@@ -326,7 +326,10 @@ void fill_boundary(ReceiverState& state, IncrementSampler& sampler) {
         sampler.sample_pair(s, t, delta * ds, delta * dt, thread, at_p, at_q, evals);
         // Into the domain is +t (bottom), -s (right), -t (top), +s (left): d/dt or d/ds.
         const double sign = (e == 0 || e == 3) ? 1.0 : -1.0;
-        return Node{sigma, at_p, (sign / delta) * (at_q - at_p)};
+        const Rgb slope_inward = (1.0 / delta) * (at_q - at_p);
+        // DESIGN: the point was moved `inset` inside; the value on the edge is its linear
+        // extrapolation back to the edge (the limit from inside, to second order in inset).
+        return Node{sigma, at_p - inset * slope_inward, sign * slope_inward};
     };
 
     for (int e = 0; e < 4; ++e) {
@@ -358,9 +361,11 @@ void fill_boundary(ReceiverState& state, IncrementSampler& sampler) {
                 const Node& n1 = open[i].first;
                 const Node& n2 = open[i].second;
                 const Node& n3 = mid[i];
+                // Segments are bisected at least down to the finest boundary leaf and at most
+                // edgefill_max_depth levels below it.
                 const double half = 0.5 * (n2.sigma - n1.sigma);
-                const bool may_stop = half <= profile.h_min * (1 + 1e-12) && depth + 1 < opt.edgefill_max_depth;
-                const bool at_cap = depth + 1 >= opt.edgefill_max_depth;
+                const bool may_stop = half <= profile.h_min * (1 + 1e-12);
+                const bool at_cap = half <= std::ldexp(profile.h_min, -opt.edgefill_max_depth) * (1 + 1e-12);
                 if (opt.edgefill_test == EdgefillTest::Variation) {
                     // The paper's test on each half: |dB(s3) - dB(s1)| and |dB_t(s3) - dB_t(s1)|.
                     auto smooth = [&](const Node& a, const Node& b) {
@@ -727,7 +732,7 @@ SplineField unify_scales(ReceiverState& state, const DualTable& dn) {
         if (stored != state.coefficients.end()) return stored->second;
         auto memo = refined.find(f);
         if (memo != refined.end()) return memo->second;
-        if (f.level == 0 || local_level(f) >= f.level) {
+        if (f.level == 0 || state.options.unify_by_projection || local_level(f) >= f.level) {
             const Rgb c = project(state, dn, f);
             state.coefficients[f] = c;
             ++state.stats.n_projections;

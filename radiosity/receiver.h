@@ -58,13 +58,16 @@ struct ReceiverOptions {
     double clamp_factor = 1.0;         // |dB_n| <= clamp_factor * max|dB| / h_min per edge
     EdgefillTest edgefill_test = EdgefillTest::Variation;
     double edgefill_tolerance = 1e-3;  // relative to the largest boundary value (derivative)
-    int edgefill_max_depth = 14;       // at most 2^14 segments per edge
+    int edgefill_max_depth = 6;        // segments no shorter than 2^-6 of the finest boundary leaf
     double divided_difference_step = 1e-4;  // Delta t of (22), in units of the finest leaf
                                             //   on that edge
-    double boundary_inset = 1e-5;      // boundary samples are taken this far inside the domain
-                                       //   (same units): the limit from inside where the
-                                       //   kernel is singular on the edge itself
+    double boundary_inset = 1e-3;      // boundary samples are taken this far inside the domain
+                                       //   (same units) and moved to the edge with the divided
+                                       //   difference: the limit from inside, where the kernel
+                                       //   is singular on the edge itself
     int shooter_coarsening = 1;        // levels by which the shooter's unshot field is coarsened
+    bool unify_by_projection = false;  // stage 8: project every finest-scale coefficient instead
+                                       //   of refining coarse ones by (17) (not the paper's rule)
     QuadratureOptions quadrature;      // the adaptive rule over the shooter, section 6
 };
 

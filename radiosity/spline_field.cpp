@@ -51,6 +51,48 @@ Rgb SplineField::evaluate(double s, double t) const {
     return sum;
 }
 
+void SplineField::evaluate_grid(const double* s, int n_s, const double* t, int n_t,
+                                Rgb* out) const {
+    MBR_CHECK(n_t <= 64);
+    const CoefficientGrid& g0 = grid_[0];
+    double bs[16], bt[64][16];
+    int fl[64];
+    for (int b = 0; b < n_t; ++b) fl[b] = bspline_values(m_, std::ldexp(t[b], level_), bt[b]);
+    for (int a = 0; a < n_s; ++a) {
+        const int fk = bspline_values(m_, std::ldexp(s[a], level_), bs);
+        // row[l] = sum_k c_{k,l} N_m(2^j s_a - k) over the m values of k, for every l needed.
+        int l_lo = fl[0], l_hi = fl[0];
+        for (int b = 1; b < n_t; ++b) {
+            l_lo = std::min(l_lo, fl[b]);
+            l_hi = std::max(l_hi, fl[b]);
+        }
+        l_hi += m_ - 1;
+        Rgb row[96];
+        MBR_CHECK(l_hi - l_lo + 1 <= 96);
+        for (int l = l_lo; l <= l_hi; ++l) {
+            Rgb sum;
+            if (l >= g0.first_l && l < g0.first_l + g0.n_l)
+                for (int i = 0; i < m_; ++i) {
+                    const int k = fk + i;
+                    if (k >= g0.first_k && k < g0.first_k + g0.n_k) sum += bs[i] * coefficient(k, l);
+                }
+            row[l - l_lo] = sum;
+        }
+        for (int b = 0; b < n_t; ++b) {
+            Rgb v;
+            for (int j = 0; j < m_; ++j) v += bt[b][j] * row[fl[b] + j - l_lo];
+            out[a * n_t + b] = v;
+        }
+    }
+}
+
+bool SplineField::is_constant() const {
+    for (const auto& g : grid_)
+        for (double v : g.a)
+            if (v != g.a.front()) return false;
+    return true;
+}
+
 SplineField SplineField::refined_to(int level) const {
     MBR_CHECK(level >= level_);
     SplineField f = *this;

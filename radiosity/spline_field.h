@@ -35,6 +35,11 @@ public:
 
     /// Eq. (20): the reconstructed value at (s, t) in [0,1]^2.
     Rgb evaluate(double s, double t) const;
+    /// Eq. (20) on a tensor grid: out[a * n_t + b] = f(s[a], t[b]). Separable, so it costs
+    /// n_s m^2 + n_s n_t m instead of n_s n_t m^2 per channel.
+    void evaluate_grid(const double* s, int n_s, const double* t, int n_t, Rgb* out) const;
+    /// True when every coefficient of each channel is the same: the field is that constant.
+    bool is_constant() const;
     /// The same function at a finer level, by eq. (17).
     SplineField refined_to(int level) const;
     /// The orthogonal projection onto a coarser level (eq. (11), math/wavelet.h): the shooter's

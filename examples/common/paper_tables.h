@@ -1,0 +1,24 @@
+// examples/common/paper_tables.h - Tables 1 and 2 of the paper (section 7): the rows, the
+// printed rea values, and the program body both table examples share.
+#pragma once
+
+#include "examples/common/cli.h"
+
+namespace mbr {
+
+struct PaperRow {
+    double h;            // distance of the parallel squares; NaN for the perpendicular ones
+    int d;               // receiver depth: leaves 2^-d wide
+    double rea_percent;  // the paper's value
+};
+
+/// Table 1: relative error between parallel squares.
+extern const PaperRow paper_table1[6];
+/// Table 2: relative error between perpendicular squares.
+extern const PaperRow paper_table2[2];
+
+/// Runs the rows, prints them beside the paper (or as CSV), the grid mean of the exact values
+/// beside the area form factor, and a summary. Returns the process exit code.
+int run_paper_table(Args& args, const PaperRow* rows, int n_rows, bool parallel);
+
+}  // namespace mbr

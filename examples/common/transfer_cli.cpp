@@ -1,0 +1,78 @@
+// examples/common/transfer_cli.cpp - shared options and measurement of one transfer.
+#include "examples/common/transfer_cli.h"
+
+#include <sstream>
+
+namespace mbr {
+
+const char* receiver_options_usage =
+    "  --order m                 B-spline order (default 4)\n"
+    "  --extrapolation K         linear (23)-(25) (default), higher = quadratic (26), cubic (27)\n"
+    "  --rhombus-radius R        truncation radius in cells of each fulcrum's scale\n"
+    "  --eps E                   relative truncation |DN x DN| > E (default 1e-7, about 26\n"
+    "                            cells for m = 4); --rhombus-radius wins when both are given\n"
+    "  --quadrature-tolerance T  relative tolerance of the adaptive rule of (21) (default 1e-4)\n"
+    "  --unify paper|projection  stage 8: refine coarse coefficients by (17) (the paper's rule,\n"
+    "                            default) or project every finest-scale coefficient\n"
+    "  --edgefill-tolerance T    edgefill's relative tolerance (default 1e-3)\n"
+    "  --clamp C                 derivative clamp of the linear extrapolation (default 1)\n"
+    "  --coarsen-shooter L       levels the shooter's unshot field is coarsened (default 1)\n";
+
+ReceiverOptions read_receiver_options(Args& args) {
+    ReceiverOptions o;
+    o.m = args.integer("--order", o.m);
+    if (o.m < 2 || o.m > 8) throw UsageError("--order must be between 2 and 8");
+    const std::string kind = args.text("--extrapolation", "linear");
+    if (kind == "linear") o.extrapolation = Extrapolation::Linear;
+    else if (kind == "higher" || kind == "quadratic") o.extrapolation = Extrapolation::Quadratic;
+    else if (kind == "cubic") o.extrapolation = Extrapolation::Cubic;
+    else throw UsageError("--extrapolation must be linear, higher, quadratic or cubic");
+    o.truncation_eps = args.number("--eps", o.truncation_eps);
+    if (!(o.truncation_eps > 0 && o.truncation_eps < 1)) throw UsageError("--eps must be in (0, 1)");
+    o.rhombus_radius = args.number("--rhombus-radius", 0);
+    if (o.rhombus_radius < 0 || o.rhombus_radius > 200)
+        throw UsageError("--rhombus-radius must be between 0 and 200 cells");
+    o.quadrature.rel_tolerance = args.number("--quadrature-tolerance", o.quadrature.rel_tolerance);
+    if (!(o.quadrature.rel_tolerance > 0 && o.quadrature.rel_tolerance < 1))
+        throw UsageError("--quadrature-tolerance must be in (0, 1)");
+    const std::string unify = args.text("--unify", "paper");
+    if (unify != "paper" && unify != "projection")
+        throw UsageError("--unify must be paper or projection");
+    o.unify_by_projection = unify == "projection";
+    o.edgefill_tolerance = args.number("--edgefill-tolerance", o.edgefill_tolerance);
+    if (!(o.edgefill_tolerance > 0)) throw UsageError("--edgefill-tolerance must be positive");
+    o.clamp_factor = args.number("--clamp", o.clamp_factor);
+    if (!(o.clamp_factor > 0)) throw UsageError("--clamp must be positive");
+    o.shooter_coarsening = args.integer("--coarsen-shooter", o.shooter_coarsening);
+    if (o.shooter_coarsening < 0) throw UsageError("--coarsen-shooter must be >= 0");
+    return o;
+}
+
+std::string describe(const ReceiverOptions& o) {
+    std::ostringstream os;
+    const char* extrapolation = o.extrapolation == Extrapolation::Linear      ? "linear (23)-(25)"
+                                : o.extrapolation == Extrapolation::Quadratic ? "quadratic (26)"
+                                                                              : "cubic (27)";
+    os << "m = " << o.m << ", " << extrapolation << " extrapolation, ";
+    if (o.rhombus_radius > 0)
+        os << "rhombus radius " << o.rhombus_radius << " cells";
+    else
+        os << "eps = " << o.truncation_eps;
+    os << ", quadrature tolerance " << o.quadrature.rel_tolerance << ", "
+       << (o.unify_by_projection ? "unification by projection" : "unification by (17)");
+    return os.str();
+}
+
+TransferRun run_transfer(const TransferSetup& setup, const ReceiverOptions& options, int grid,
+                         ReceiverState* keep_state) {
+    TransferRun run;
+    const SplineField unshot = SplineField::constant(options.m, 0, {1, 1, 1});
+    const Shooter shooter = make_shooter(setup.shooter, unshot, options.shooter_coarsening);
+    const ReceiverSurface receiver{&setup.receiver, [](double, double) { return Rgb{1, 1, 1}; }};
+    run.field = transfer(shooter, receiver, options, &run.stats, keep_state);
+    run.errors = compare_with_exact(run.field, setup, 1, 1, grid);
+    run.n_coefficients = touching_count(options.m, run.field.level()) * touching_count(options.m, run.field.level());
+    return run;
+}
+
+}  // namespace mbr

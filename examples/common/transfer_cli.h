@@ -1,0 +1,34 @@
+// examples/common/transfer_cli.h - the options every single-transfer program understands, and
+// the measurement of one transfer against the analytic form factor (Tables 1-2, Figure 7).
+#pragma once
+
+#include <string>
+
+#include "examples/common/cli.h"
+#include "radiosity/receiver.h"
+#include "radiosity/reference.h"
+
+namespace mbr {
+
+/// Usage lines for the options below.
+extern const char* receiver_options_usage;
+
+/// Reads --order, --extrapolation linear|higher|quadratic|cubic, --rhombus-radius R, --eps E,
+/// --quadrature-tolerance, --unify paper|projection, --edgefill-tolerance, --clamp,
+/// --coarsen-shooter into ReceiverOptions (depths are left to the caller).
+ReceiverOptions read_receiver_options(Args& args);
+
+/// A one-line description of the options that matter for the tables.
+std::string describe(const ReceiverOptions& options);
+
+/// One transfer with shooter radiosity 1 and receiver reflectance 1, measured on the n x n grid.
+struct TransferRun {
+    ErrorStats errors;
+    TransferStats stats;
+    SplineField field;
+    int n_coefficients = 0;
+};
+TransferRun run_transfer(const TransferSetup& setup, const ReceiverOptions& options,
+                         int grid = 256, ReceiverState* keep_state = nullptr);
+
+}  // namespace mbr
