@@ -599,10 +599,53 @@ std::vector<Fulcrum> select_fulcrums(const Forest& forest, int m) {
 
 // ---- Stage 6: projection in the rhombus, eq. (19) ----------------------------------------
 
+namespace {
+/// The deepest leaf level of the forest.
+int finest_level(const Forest& forest) {
+    int level = 0;
+    for (int index = 0; index < forest.n_nodes(); ++index)
+        level = std::max(level, forest.node(index).cell.level);
+    return level;
+}
+}  // namespace
+
+ProjectionTables make_projection_tables(int m, const DualTable& dn, double rhombus_radius,
+                                        int max_levels) {
+    ProjectionTables t;
+    t.m = m;
+    t.rule = gauss_legendre(m);
+    // Offsets o = i - k of cells that can meet a rhombus: the fulcrum is at k + m/2.
+    const int reach = static_cast<int>(std::ceil(rhombus_radius)) + m + 2;
+    t.first_offset = -reach;
+    t.n_offsets = 2 * reach + 1;
+    t.dn_at_nodes.resize(size_t(t.n_offsets) * m);
+    for (int i = 0; i < t.n_offsets; ++i)
+        for (int a = 0; a < m; ++a)
+            t.dn_at_nodes[size_t(i) * m + a] = dn(t.first_offset + i + 0.5 * (t.rule.x[a] + 1));
+    t.resample.resize(max_levels + 1);
+    for (int levels = 1; levels <= max_levels; ++levels) {
+        std::vector<double>& block = t.resample[levels];
+        const int n_sub = 1 << levels;
+        block.reserve(size_t(n_sub) * m * m);
+        for (int index = 0; index < n_sub; ++index) {
+            const std::vector<double> R = subcell_resample_matrix(t.rule, levels, index);
+            block.insert(block.end(), R.begin(), R.end());
+        }
+    }
+    return t;
+}
+
 Rgb project(const ReceiverState& state, const DualTable& dn, const Fulcrum& f) {
+    const int levels = std::max(0, f.level);
+    return project(state, dn, make_projection_tables(state.options.m, dn, state.rhombus_radius, levels), f);
+}
+
+Rgb project(const ReceiverState& state, const DualTable& dn, const ProjectionTables& tables,
+            const Fulcrum& f) {
     const int m = state.options.m;
+    MBR_CHECK(tables.m == m);
     const Forest& forest = state.forest;
-    const GaussLegendre rule = gauss_legendre(m);
+    const GaussLegendre& rule = tables.rule;
     const double scale = std::ldexp(1.0, f.level);  // x = 2^L s
     const Vec2 centre = f.position(m);
     const double R = state.rhombus_radius / scale;  // rhombus radius in parameter units
@@ -610,15 +653,25 @@ Rgb project(const ReceiverState& state, const DualTable& dn, const Fulcrum& f) {
     // m x m Gauss-Legendre on a rectangle of the fulcrum's scale or finer, where DN_m(x - k) is
     // one polynomial piece: c += sum_a sum_b w_a w_b J DN(x_a - k) DN(y_b - l) dB_ab, with J the
     // Jacobian of [-1,1]^2 -> the rectangle in x = 2^L s units (not the area factor A_i).
+    // Cells of exactly the fulcrum's scale take DN from the table of node values.
     Rgb sum;
     auto integrate_cell = [&](const Rect& r, const Rgb* f_ab) {
         double wx[16], wy[16];
         const double hx = 0.5 * r.width() * scale, hy = 0.5 * r.height() * scale;
-        for (int a = 0; a < m; ++a) {
-            const double x = (r.x0 + 0.5 * (rule.x[a] + 1) * r.width()) * scale - f.k;
-            const double y = (r.y0 + 0.5 * (rule.x[a] + 1) * r.height()) * scale - f.l;
-            wx[a] = rule.w[a] * hx * dn(x);
-            wy[a] = rule.w[a] * hy * dn(y);
+        if (hx == 0.5 && hy == 0.5) {
+            const int ox = static_cast<int>(std::lround(r.x0 * scale)) - f.k;
+            const int oy = static_cast<int>(std::lround(r.y0 * scale)) - f.l;
+            for (int a = 0; a < m; ++a) {
+                wx[a] = rule.w[a] * hx * tables.dn(ox, a);
+                wy[a] = rule.w[a] * hy * tables.dn(oy, a);
+            }
+        } else {
+            for (int a = 0; a < m; ++a) {
+                const double x = (r.x0 + 0.5 * (rule.x[a] + 1) * r.width()) * scale - f.k;
+                const double y = (r.y0 + 0.5 * (rule.x[a] + 1) * r.height()) * scale - f.l;
+                wx[a] = rule.w[a] * hx * dn(x);
+                wy[a] = rule.w[a] * hy * dn(y);
+            }
         }
         for (int a = 0; a < m; ++a) {
             if (wx[a] == 0) continue;
@@ -636,7 +689,6 @@ Rgb project(const ReceiverState& state, const DualTable& dn, const Fulcrum& f) {
     std::vector<int> stack;
     for (int J = J0; J <= J1; ++J)
         for (int I = I0; I <= I1; ++I) stack.push_back(forest.root(I, J));
-    std::vector<double> Rx, Ry;
     Rgb resampled[256];
     double channel_in[256], channel_out[256];
     while (!stack.empty()) {
@@ -659,13 +711,15 @@ Rgb project(const ReceiverState& state, const DualTable& dn, const Fulcrum& f) {
         // The leaf is coarser than the dual: fit the tensor polynomial of degree m-1 to its
         // samples (the Lagrange interpolant at the Gauss-Legendre nodes), split the leaf to
         // the fulcrum's scale and resample it on the sub-cells that meet the rhombus.
+        MBR_CHECK_MSG(levels < int(tables.resample.size()), "no resampling table for " << levels << " levels");
+        const std::vector<double>& block = tables.resample[levels];
         const int n_sub = 1 << levels;
         const double h = r.width() / n_sub;
         for (int p = 0; p < n_sub; ++p) {
             const Rect strip{r.x0 + p * h, r.x0 + (p + 1) * h, r.y0, r.y1};
             const double dx = rhombus_distance(strip, centre);
             if (dx > R) continue;
-            Rx = subcell_resample_matrix(rule, levels, p);
+            const double* Rx = &block[size_t(p) * m * m];
             // Sub-cells q of this strip within the rhombus: |t - cy| <= R - dx.
             const double reach = R - dx;
             const int q0 = std::max(0, static_cast<int>(std::floor((centre.y - reach - r.y0) / h)));
@@ -673,10 +727,10 @@ Rgb project(const ReceiverState& state, const DualTable& dn, const Fulcrum& f) {
             for (int q = q0; q <= q1; ++q) {
                 const Rect sub{strip.x0, strip.x1, r.y0 + q * h, r.y0 + (q + 1) * h};
                 if (rhombus_distance(sub, centre) > R) continue;
-                Ry = subcell_resample_matrix(rule, levels, q);
+                const double* Ry = &block[size_t(q) * m * m];
                 for (int c = 0; c < 3; ++c) {
                     for (int i = 0; i < m * m; ++i) channel_in[i] = f_ab[i][c];
-                    resample(m, channel_in, Rx.data(), Ry.data(), channel_out);
+                    resample(m, channel_in, Rx, Ry, channel_out);
                     for (int i = 0; i < m * m; ++i) resampled[i][c] = channel_out[i];
                 }
                 integrate_cell(sub, resampled);
@@ -687,10 +741,14 @@ Rgb project(const ReceiverState& state, const DualTable& dn, const Fulcrum& f) {
 }
 
 void project_in_rhombi(ReceiverState& state, const DualTable& dn) {
+    // Fulcrums are no finer than the finest leaf and leaves no coarser than level 0.
+    state.tables = std::make_shared<const ProjectionTables>(
+        make_projection_tables(state.options.m, dn, state.rhombus_radius, finest_level(state.forest)));
+    const ProjectionTables& tables = *state.tables;
     const int n = static_cast<int>(state.fulcrums.size());
     std::vector<Rgb> values(n);
 #pragma omp parallel for schedule(dynamic, 4)
-    for (int i = 0; i < n; ++i) values[i] = project(state, dn, state.fulcrums[i]);
+    for (int i = 0; i < n; ++i) values[i] = project(state, dn, tables, state.fulcrums[i]);
     for (int i = 0; i < n; ++i) state.coefficients[state.fulcrums[i]] = values[i];
     state.stats.n_projections += n;
 }
@@ -700,10 +758,9 @@ void project_in_rhombi(ReceiverState& state, const DualTable& dn) {
 SplineField unify_scales(ReceiverState& state, const DualTable& dn) {
     const int m = state.options.m;
     const Forest& forest = state.forest;
-    int j = 0, finest_leaf = 0;
+    int j = 0;
     for (const Fulcrum& f : state.fulcrums) j = std::max(j, f.level);
-    for (int index = 0; index < forest.n_nodes(); ++index)
-        finest_leaf = std::max(finest_leaf, forest.node(index).cell.level);
+    const int finest_leaf = finest_level(forest);
     const std::vector<double> p_mk = two_scale_mask(m);
 
     // The finest leaf level around a fulcrum's position: its own cell for odd m (a centre),
@@ -733,7 +790,7 @@ SplineField unify_scales(ReceiverState& state, const DualTable& dn) {
         auto memo = refined.find(f);
         if (memo != refined.end()) return memo->second;
         if (f.level == 0 || state.options.unify_by_projection || local_level(f) >= f.level) {
-            const Rgb c = project(state, dn, f);
+            const Rgb c = state.tables ? project(state, dn, *state.tables, f) : project(state, dn, f);
             state.coefficients[f] = c;
             ++state.stats.n_projections;
             return c;

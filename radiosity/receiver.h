@@ -56,8 +56,11 @@ struct ReceiverOptions {
     double rhombus_radius = 0;         // in cells of the fulcrum's scale; 0: from truncation_eps
     Extrapolation extrapolation = Extrapolation::Linear;
     double clamp_factor = 1.0;         // |dB_n| <= clamp_factor * max|dB| / h_min per edge
-    EdgefillTest edgefill_test = EdgefillTest::Variation;
-    double edgefill_tolerance = 1e-3;  // relative to the largest boundary value (derivative)
+    EdgefillTest edgefill_test = EdgefillTest::Linearity;  // DESIGN: the chord test; the
+                                       //   paper's Variation test gives the same rea with ~3x
+                                       //   the boundary samples (docs/method.md)
+    double edgefill_tolerance = 1e-4;  // relative to the largest sample (derivatives: per
+                                       //   finest boundary leaf)
     int edgefill_max_depth = 6;        // segments no shorter than 2^-6 of the finest boundary leaf
     double divided_difference_step = 1e-4;  // Delta t of (22), in units of the finest leaf
                                             //   on that edge
@@ -120,6 +123,22 @@ struct Fulcrum {
     bool operator==(const Fulcrum& o) const { return level == o.level && k == o.k && l == o.l; }
 };
 
+/// What projection looks up instead of recomputing (section 5, "Projection": "The sample values
+/// of the dual basis function are approximated by precalculated discrete values"): DN_m at the
+/// m Gauss-Legendre nodes of every unit cell within reach of a fulcrum, and the matrices that
+/// resample a leaf's samples onto its sub-cells 1, 2, ... levels finer.
+struct ProjectionTables {
+    int m = 0;
+    GaussLegendre rule;                       // the m-point rule of the leaf samples
+    int first_offset = 0, n_offsets = 0;      // cell offsets o = i - k covered
+    std::vector<double> dn_at_nodes;          // DN_m(o + (x_a + 1) / 2) at [(o - first) m + a]
+    std::vector<std::vector<double>> resample;  // [levels][index * m * m ...] sub-cell matrices
+    /// DN_m at node a of the unit cell at offset o (zero beyond the table).
+    double dn(int o, int a) const {
+        const int i = o - first_offset;
+        return (i >= 0 && i < n_offsets) ? dn_at_nodes[size_t(i) * m + a] : 0.0;
+    }
+};
 /// Everything one transfer builds, stage after stage.
 struct ReceiverState {
     ReceiverOptions options;
@@ -130,6 +149,7 @@ struct ReceiverState {
     std::vector<Fulcrum> fulcrums;        // stage 5
     std::map<Fulcrum, Rgb> coefficients;  // stage 6 (and on-demand ones from stage 8)
     double rhombus_radius = 0;            // in cells of each fulcrum's own scale
+    std::shared_ptr<const ProjectionTables> tables;  // built by project_in_rhombi
     TransferStats stats;
 };
 
@@ -194,11 +214,18 @@ std::vector<Fulcrum> select_fulcrums(const Forest& forest, int m);
 /// walking the quadtrees from their roots (done in parallel over fulcrums).
 void project_in_rhombi(ReceiverState& state, const DualTable& dn);
 
+/// Tables for fulcrums with the given rhombus radius (cells) and resampling up to max_levels.
+ProjectionTables make_projection_tables(int m, const DualTable& dn, double rhombus_radius,
+                                        int max_levels);
+
 /// The projection of one coefficient: 4^L int int dB(s,t) DN_m(2^L s - k) DN_m(2^L t - l) ds dt
 /// over the cells that meet the fulcrum's rhombus; m x m Gauss-Legendre on each leaf with the
 /// leaf's samples, or, on a leaf coarser than the fulcrum, on the sub-cells of the fulcrum's
 /// scale after fitting the tensor polynomial and resampling it.
 Rgb project(const ReceiverState& state, const DualTable& dn, const Fulcrum& f);
+/// The same with prepared tables (what the stages use).
+Rgb project(const ReceiverState& state, const DualTable& dn, const ProjectionTables& tables,
+            const Fulcrum& f);
 
 /// Stage 8. Every coefficient at the finest fulcrum scale 2^-j, for the basis functions that
 /// touch [0,1]^2: a stored one is used; a missing one at a fulcrum whose neighbourhood is at

@@ -14,7 +14,9 @@ const char* receiver_options_usage =
     "  --quadrature-tolerance T  relative tolerance of the adaptive rule of (21) (default 1e-4)\n"
     "  --unify paper|projection  stage 8: refine coarse coefficients by (17) (the paper's rule,\n"
     "                            default) or project every finest-scale coefficient\n"
-    "  --edgefill-tolerance T    edgefill's relative tolerance (default 1e-3)\n"
+    "  --edgefill-tolerance T    edgefill's relative tolerance (default 1e-4)\n"
+    "  --edgefill chord|paper    edgefill's test: the midpoint against the chord (default),\n"
+    "                            or the paper's |dB(s3) - dB(s1)| small\n"
     "  --clamp C                 derivative clamp of the linear extrapolation (default 1)\n"
     "  --coarsen-shooter L       levels the shooter's unshot field is coarsened (default 1)\n";
 
@@ -41,6 +43,9 @@ ReceiverOptions read_receiver_options(Args& args) {
     o.unify_by_projection = unify == "projection";
     o.edgefill_tolerance = args.number("--edgefill-tolerance", o.edgefill_tolerance);
     if (!(o.edgefill_tolerance > 0)) throw UsageError("--edgefill-tolerance must be positive");
+    const std::string edgefill = args.text("--edgefill", "chord");
+    if (edgefill != "chord" && edgefill != "paper") throw UsageError("--edgefill must be chord or paper");
+    o.edgefill_test = edgefill == "paper" ? EdgefillTest::Variation : EdgefillTest::Linearity;
     o.clamp_factor = args.number("--clamp", o.clamp_factor);
     if (!(o.clamp_factor > 0)) throw UsageError("--clamp must be positive");
     o.shooter_coarsening = args.integer("--coarsen-shooter", o.shooter_coarsening);
