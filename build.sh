@@ -32,11 +32,28 @@ configure_and_build() {  # dir, extra cmake arguments...
 
 main_job() {
     mkdir -p out
+    echo "== Table 1: parallel squares, beside the paper =="
+    build/examples/table1_parallel_squares
+    echo
+    echo "== Table 1 again with the rhombus radius near the paper's (14 cells) =="
+    build/examples/table1_parallel_squares --rhombus-radius 14
+    echo
+    echo "== Table 2: perpendicular squares, beside the paper =="
+    build/examples/table2_perpendicular_squares
+    echo
+    echo "== Table 2 again with the rhombus radius near the paper's (14 cells) =="
+    build/examples/table2_perpendicular_squares --rhombus-radius 14
+    echo
     echo "== Table 3: dual coefficients mu_{3;0,l} beside the paper =="
     build/examples/table3_dual_coefficients
     echo
     echo "== Figure 1: DN_3 and DN_4 -> out/figure1_dual_basis.png =="
     build/examples/figure1_dual_basis -o out/figure1_dual_basis.png
+    if [ -x build/examples/figure7_error_images ]; then
+        echo
+        echo "== Figure 7: error images -> out/figure7a_parallel.png, out/figure7b_perpendicular.png =="
+        build/examples/figure7_error_images -o out
+    fi
 }
 
 case "${1:-}" in
