@@ -117,10 +117,16 @@ auto adaptive_integrate_1d(F&& f, double a, double b, const AdaptiveOptions& opt
 /// cell_rule(cell, n) returns the n x n tensor Gauss-Legendre value on cell.rect. (The
 /// radiosity kernel uses this form to cache the shooter's points per cell.) Splits a cell into
 /// four children with a quarter of its tolerance each. Evaluations are counted as n^2 + (n+1)^2
-/// per visited cell.
-template <class CellRule>
+/// per visited cell. force_split(cell) may declare a cell untrustworthy however well the two
+/// rules agree (it is then split, up to max_depth).
+/// Never split by a geometric rule (the default of adaptive_tensor_rule_2d).
+struct NoForcedSplit {
+    bool operator()(const QuadCell&) const { return false; }
+};
+
+template <class CellRule, class ForceSplit = NoForcedSplit>
 auto adaptive_tensor_rule_2d(CellRule&& cell_rule, const Rect& domain, const AdaptiveOptions& opt,
-                             bool keep_cells = false) {
+                             bool keep_cells = false, ForceSplit&& force_split = ForceSplit{}) {
     using V = decltype(cell_rule(QuadCell{}, 1));
     AdaptiveResult<V> result;
     struct Work { QuadCell cell; double tol; };
@@ -133,7 +139,8 @@ auto adaptive_tensor_rule_2d(CellRule&& cell_rule, const Rect& domain, const Ada
         V f1 = cell_rule(w.cell, opt.n + 1);
         result.n_evaluations += evals_per_cell;
         if (w.cell.level > result.depth) result.depth = w.cell.level;
-        bool agree = max_abs(f1 - f0) <= w.tol;
+        // A cell the caller does not trust (force_split) is split whatever the rules say.
+        bool agree = max_abs(f1 - f0) <= w.tol && !force_split(w.cell);
         if (agree || w.cell.level >= opt.max_depth) {
             if (!agree) result.converged = false;
             result.value += f1;

@@ -121,7 +121,19 @@ IncrementIntegrator::Result IncrementIntegrator::integrate(const SurfacePoint& p
     opt.max_depth = options_.max_depth;
     opt.min_share = options_.min_share;
     auto cell_rule = [&](const QuadCell& cell, int n) { return sum_over(p, points(cell, n)); };
-    auto r = adaptive_tensor_rule_2d(cell_rule, root.rect, opt, keep_partition);
+    // DESIGN: the n against n+1 test can accept a cell whose nodes all miss a peak narrower
+    // than their spacing, which is what a receiving point close to the shooter sees. A cell is
+    // trusted only when it is well separated from p: its points' extent at most near_field
+    // times their distance from p.
+    auto near = [&](const QuadCell& cell) {
+        if (options_.near_field <= 0) return false;
+        const PointSpan pts = points(cell, options_.n + 1);
+        Box3 box;
+        for (int i = 0; i < pts.count; ++i) box.extend(pts.first[i].x);
+        const Vec3 gap = max(max(box.lo - p.position, p.position - box.hi), Vec3{0, 0, 0});
+        return length(box.extent()) > options_.near_field * length(gap);
+    };
+    auto r = adaptive_tensor_rule_2d(cell_rule, root.rect, opt, keep_partition, near);
     result.value = r.value;
     result.n_evaluations = r.n_evaluations + long(options_.n + 1) * (options_.n + 1);
     result.converged = r.converged;
