@@ -112,6 +112,14 @@ std::vector<Polygon> scene_polygons(const Scene& scene, int tessellation,
         const size_t first = polygons.size();
         for (const Facet& facet : scene.surfaces[id].surface.tessellate(tessellation)) {
             ++s.n_facets;
+            if (facet.vertices.size() >= 3)
+                if (std::optional<Polygon> p = try_polygon(Piece{facet.vertices, facet.uv}, id)) {
+                    polygons.push_back(std::move(*p));
+                    continue;
+                }
+            // Refused (or fewer than three vertices): merge near-duplicates and try again. Only
+            // now, as merging changes the (u, v) map of the cell (a quad with a tiny edge is
+            // a triangle in space but not in (u, v)).
             Piece piece = merged(facet);
             if (piece.vertices.size() < 3) {
                 // Collapsed to a point or a segment: a sliver thinner than merge_tol.
@@ -119,10 +127,11 @@ std::vector<Polygon> scene_polygons(const Scene& scene, int tessellation,
                 s.dropped_area += piece_area(Piece{facet.vertices, facet.uv});
                 continue;
             }
-            if (std::optional<Polygon> p = try_polygon(piece, id)) {
-                polygons.push_back(std::move(*p));
-                continue;
-            }
+            if (piece.vertices.size() < facet.vertices.size())
+                if (std::optional<Polygon> p = try_polygon(piece, id)) {
+                    polygons.push_back(std::move(*p));
+                    continue;
+                }
             if (piece.vertices.size() == 3) {
                 ++s.n_dropped;
                 s.dropped_area += piece_area(piece);

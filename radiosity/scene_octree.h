@@ -27,15 +27,15 @@ struct ScenePolygonStats {
 /// surface in scene.surfaces and its vertices carry the facets' (u, v), so that a hit maps back
 /// through scene.surfaces[hit.surface].surface.point(hit.uv). A planar quad stays one polygon,
 /// exact (Polygon's inverse bilinear (u, v) is the quad's own map), if Polygon accepts it.
-/// Facets the Polygon constructor refuses do not stop the build: vertices closer than 1e-8 of
-/// the facet's size are merged first; a facet still refused (a quad beyond Polygon's planarity
-/// tolerance of 1e-6, such as the Cornell box's red wall at 1e-3, which the scene format allows;
-/// rounding on small facets far from the origin) becomes two triangles along a diagonal, which
-/// keeps its edges and corners, so neighbours still meet without a crack; a triangle refused
-/// even so (zero area, an angle below 1e-7 rad) covers next to nothing and is left out. Limits
-/// of Polygon, not of the surfaces: facets thinner than about 1e-8 of their length, or smaller
-/// than about 1e-10 of their distance from the origin (where rounding of the coordinates beats
-/// Polygon's planarity tolerance, even for triangles), are partly or wholly lost. *stats, if
+/// Facets the Polygon constructor refuses do not stop the build: vertices closer than 1e-8 of the
+/// facet's size are merged and the facet is tried again; a facet still refused (a quad beyond
+/// Polygon's planarity tolerance of 1e-6, such as the Cornell box's red wall at 1e-3, which the
+/// scene format allows; rounding on small facets far from the origin) becomes two triangles along a
+/// diagonal, which keeps its edges and corners, so neighbours still meet without a crack; a
+/// triangle refused even so (zero area, an angle below 1e-7 rad) covers next to nothing and is left
+/// out. Limits of Polygon, not of the surfaces: facets thinner than about 1e-8 of their length, or
+/// smaller than about 1e-10 of their distance from the origin (where rounding of the coordinates
+/// beats Polygon's planarity tolerance, even for triangles), are partly or wholly lost. *stats, if
 /// given, counts all this; n_dropped and n_empty_surfaces are zero for any reasonable scene.
 std::vector<Polygon> scene_polygons(const Scene& scene, int tessellation,
                                     ScenePolygonStats* stats = nullptr);
