@@ -19,9 +19,10 @@
 //         e.g. build/examples/octree_stats examples/scenes/room.scene
 // Expect: zero disagreements (exit status 1 otherwise). On the room (8078 polygons at
 //         tessellation 24) about 5 nodes and 5 polygon tests per closest-hit ray and 9 nodes and
-//         7 tests per shadow segment instead of 8078 and 7400, a speed-up near 70 and 45 (the
-//         brute-force loop takes about 16 of the 17 seconds). On the other examples (2 to 17
-//         polygons) the octree gains nothing: the loop over all polygons is 2-3 times faster.
+//         7 tests per shadow segment instead of 8078 and 7400, a speed-up of 65-100 and 40-45
+//         (timings vary from run to run; the brute-force loop takes about 16 of the 17 seconds).
+//         On the other examples (2 to 17 polygons) the octree gains nothing: the loop over all
+//         polygons is 2-3 times faster.
 #include <algorithm>
 #include <cmath>
 #include <iostream>
