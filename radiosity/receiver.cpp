@@ -482,21 +482,21 @@ void expand_domain(ReceiverState& state, IncrementSampler& sampler) {
     const int m = opt.m;
     Forest& forest = state.forest;
 
-    // Domain leaves on the boundary: their sizes fix the width of the ring and the size of the
-    // expanded cells next to them.
+    // Domain leaves on the boundary fix the size of the expanded cells next to them. Every
+    // leaf's fulcrums (and the expanded ones half a support outside) need their rhombus inside
+    // the ring: a leaf of size h at distance g from the boundary asks for a ring of
+    // (r + m + 1) h - g, r the rhombus radius in cells.
     std::vector<Rect> boundary;
-    double h_coarse = 0, h_fine = 1;
+    double h_fine = 1, width = 0;
     for (int index : forest.leaves(Forest::Region::Domain)) {
         const Rect r = forest.node(index).cell.rect();
         if (r.x0 == 0 || r.y0 == 0 || r.x1 == 1 || r.y1 == 1) {
             boundary.push_back(r);
-            h_coarse = std::max(h_coarse, r.width());
             h_fine = std::min(h_fine, r.width());
         }
+        const double gap = std::min({r.x0, r.y0, 1 - r.x1, 1 - r.y1});
+        width = std::max(width, (state.rhombus_radius + m + 1) * r.width() - gap);
     }
-    // Wide enough for the truncated dual support of every boundary fulcrum and of the
-    // expanded fulcrums half a support further out.
-    const double width = (state.rhombus_radius + m + 1) * h_coarse;
     forest.grow(static_cast<int>(std::ceil(width)));
     const int fine_level = static_cast<int>(std::lround(-std::log2(h_fine)));
 
@@ -717,10 +717,11 @@ Rgb project(const ReceiverState& state, const DualTable& dn, const ProjectionTab
         const double h = r.width() / n_sub;
         for (int p = 0; p < n_sub; ++p) {
             const Rect strip{r.x0 + p * h, r.x0 + (p + 1) * h, r.y0, r.y1};
-            const double dx = rhombus_distance(strip, centre);
+            // The strip's distance from the centre along s alone: the sub-cells of this strip
+            // within the rhombus are those with |t - cy| <= R - dx.
+            const double dx = std::max({0.0, strip.x0 - centre.x, centre.x - strip.x1});
             if (dx > R) continue;
             const double* Rx = &block[size_t(p) * m * m];
-            // Sub-cells q of this strip within the rhombus: |t - cy| <= R - dx.
             const double reach = R - dx;
             const int q0 = std::max(0, static_cast<int>(std::floor((centre.y - reach - r.y0) / h)));
             const int q1 = std::min(n_sub - 1, static_cast<int>(std::floor((centre.y + reach - r.y0) / h)));
