@@ -51,19 +51,21 @@ std::string usage() {
                "  perpendicular squares, d = 3. Writes DIR/figure7a_parallel.png and\n"
                "  DIR/figure7b_perpendicular.png.\n"
                "  -o DIR                    existing output directory (required)\n"
-               "  --grid N                  sample grid N x N, 16..1024 (default 256, as eq. (29))\n"
+               "  --grid N                  sample grid N x N, 16..1024 (default 256, as eq. "
+               "(29))\n"
                "  --error-max E             relative error at full colour, 1e-9..10 (default:\n"
-               "                            the 99th percentile rounded up to 1, 2 or 5 x 10^k)\n") +
+               "                            the 99th percentile rounded up to 1, 2 or 5 x "
+               "10^k)\n") +
            receiver_options_usage;
 }
 
 // One panel of Figure 7, measured: the three grids (row-major, s fastest, t upwards) and the
 // numbers printed on the image and on stdout.
 struct Measured {
-    std::string label;      // "(a)" or "(b)"
-    std::string geometry;   // "parallel unit squares, h = 0.5"
+    std::string label;     // "(a)" or "(b)"
+    std::string geometry;  // "parallel unit squares, h = 0.5"
     int depth = 0;
-    int n = 0;              // grid size
+    int n = 0;  // grid size
     std::vector<double> exact, approx, relative;
     TransferRun run;
     double value_min = 0, value_max = 0;  // shared range of the upper panels
@@ -80,9 +82,8 @@ double nice_ceiling(double x) {
     return 10 * decade;
 }
 
-Measured measure(const std::string& label, const std::string& geometry,
-                 const TransferSetup& setup, int depth, ReceiverOptions options, int n,
-                 double error_max) {
+Measured measure(const std::string& label, const std::string& geometry, const TransferSetup& setup,
+                 int depth, ReceiverOptions options, int n, double error_max) {
     Measured out;
     out.label = label;
     out.geometry = geometry;
@@ -146,28 +147,28 @@ std::string percent(double fraction, int digits = 3) {
 std::string magnification(double error_max) {
     const double n = 1 / error_max;
     return std::fabs(n - std::round(n)) < 1e-6 * n && n < 1e9 ? cell(std::round(n), 0)
-                                                               : cell_g(n, 4);
+                                                              : cell_g(n, 4);
 }
 
 Image compose(const Measured& M, const ReceiverOptions& options) {
-    const int s = 2;                                    // text scale of labels and ticks
+    const int s = 2;                                        // text scale of labels and ticks
     const int area = M.n <= 512 ? M.n * (512 / M.n) : M.n;  // whole pixels per sample
-    const int margin = axes_margin(s, 4);               // left of and below each field
-    const int title_h = 2 * glyph_line_height * s;      // above each panel
+    const int margin = axes_margin(s, 4);                   // left of and below each field
+    const int title_h = 2 * glyph_line_height * s;          // above each panel
     const int pad = 16 * s;
     const int panel_w = margin + area + pad, panel_h = title_h + area + margin;
     const int width = 2 * panel_w + pad;
 
     // Header: what is shown, under which options, wrapped to the image width.
-    const std::string title = "Figure 7" + M.label + ": " + M.geometry + ", d = " +
-                              std::to_string(M.depth);
+    const std::string title =
+        "Figure 7" + M.label + ": " + M.geometry + ", d = " + std::to_string(M.depth);
     const std::vector<std::string> subtitle = wrap_text(
         "Relative error of a single energy transfer (shooter radiosity 1, reflectance 1); " +
             describe(options) + "; sample points: the " + std::to_string(M.n) + " x " +
             std::to_string(M.n) + " cell centres of [0,1]^2.",
         width - 2 * pad, s);
-    const int header_h = pad / 2 + glyph_line_height * 3 +
-                         int(subtitle.size()) * glyph_line_height * s + pad;
+    const int header_h =
+        pad / 2 + glyph_line_height * 3 + int(subtitle.size()) * glyph_line_height * s + pad;
     Image image(width, header_h + 2 * panel_h + pad / 2, {1, 1, 1});
     Canvas canvas(image);
     const Rgb ink{0, 0, 0};
@@ -190,15 +191,14 @@ Image compose(const Measured& M, const ReceiverOptions& options) {
 
     // Upper row: exact and approximation in one colour range.
     const PixelRect exact_area = field_area(0, 0), approx_area = field_area(1, 0);
-    draw_scalar_field(image, exact_area, flipped(M.exact, M.n), M.n, M.n, M.value_min,
-                      M.value_max);
+    draw_scalar_field(image, exact_area, flipped(M.exact, M.n), M.n, M.n, M.value_min, M.value_max);
     draw_scalar_field(image, approx_area, flipped(M.approx, M.n), M.n, M.n, M.value_min,
                       M.value_max);
     frame(exact_area);
     frame(approx_area);
     panel_title(exact_area, "exact (analytic form factor)");
-    panel_title(approx_area, "B-spline, d = " + std::to_string(M.depth) +
-                                 ", m = " + std::to_string(options.m));
+    panel_title(approx_area,
+                "B-spline, d = " + std::to_string(M.depth) + ", m = " + std::to_string(options.m));
 
     // Lower right: the magnified relative error; points beyond E in black.
     const PixelRect error_area = field_area(1, 1);
@@ -222,17 +222,18 @@ Image compose(const Measured& M, const ReceiverOptions& options) {
     const int line = glyph_line_height * s;
     const int bar_w = scale_area.w - 2 * pad, bar_h = 12 * s;
     int y = scale_area.y + line + 2 * s;
-    draw_colour_scale(image, {scale_area.x + pad, y, bar_w, bar_h}, M.value_min, M.value_max,
-                      "B (both upper panels): " + cell(M.value_min, 4) + " .. " +
-                          cell(M.value_max, 4),
-                      colour_map, s);
+    draw_colour_scale(
+        image, {scale_area.x + pad, y, bar_w, bar_h}, M.value_min, M.value_max,
+        "B (both upper panels): " + cell(M.value_min, 4) + " .. " + cell(M.value_max, 4),
+        colour_map, s);
     y += bar_h + 3 * line + 2 * s;
     draw_colour_scale(image, {scale_area.x + pad, y, bar_w, bar_h}, 0, 100 * M.error_max,
                       "relative error in % (lower right)", error_map, s);
     y += bar_h + 2 * line;
     const int x0 = scale_area.x + pad;
-    canvas.text(x0, y, "magnification x " + magnification(M.error_max) + ": full red at " +
-                           percent(M.error_max, 2),
+    canvas.text(x0, y,
+                "magnification x " + magnification(M.error_max) + ": full red at " +
+                    percent(M.error_max, 2),
                 ink, s);
     y += line;
     canvas.fill_rect({x0, y, 7 * s, 7 * s}, clipped_colour);
@@ -248,10 +249,10 @@ Image compose(const Measured& M, const ReceiverOptions& options) {
           "max relative error  = " + percent(e.max_rel, 3),
           "  at (s, t)         = (" + cell(M.argmax_s, 3) + ", " + cell(M.argmax_t, 3) + ")",
           "mean of exact       = " + cell(e.mean_exact, 6),
-          "leaves " + std::to_string(st.n_leaves) + ", fulcrums " +
-              std::to_string(st.n_fulcrums) + ", level j = " + std::to_string(st.level),
-          "rhombus radius " + cell(st.rhombus_radius, 2) + " cells, " +
-              cell(st.seconds_total, 2) + " s"}) {
+          "leaves " + std::to_string(st.n_leaves) + ", fulcrums " + std::to_string(st.n_fulcrums) +
+              ", level j = " + std::to_string(st.level),
+          "rhombus radius " + cell(st.rhombus_radius, 2) + " cells, " + cell(st.seconds_total, 2) +
+              " s"}) {
         canvas.text(x0, y, text, ink, s);
         y += line;
     }
@@ -260,7 +261,8 @@ Image compose(const Measured& M, const ReceiverOptions& options) {
     for (const std::string& text :
          wrap_text("The upper panels share one colour range: equal colours are equal values. "
                    "The lower right shows |B_spline - B_exact| / B_exact at every sample point, "
-                   "white where it vanishes, full red at " + percent(M.error_max, 2) + ".",
+                   "white where it vanishes, full red at " +
+                       percent(M.error_max, 2) + ".",
                    scale_area.w - pad, s)) {
         if (y + line > scale_area.bottom()) break;
         canvas.text(x0, y, text, {0.3, 0.3, 0.3}, s);
@@ -285,9 +287,8 @@ int run(Args& args) {
 
     const Measured a = measure("(a)", "parallel unit squares, h = 0.5", parallel_squares(0.5), 4,
                                options, n, error_max);
-    const Measured b = measure("(b)",
-                               "perpendicular unit squares (the shooter stands on t = 0)", perpendicular_squares(), 3,
-                               options, n, error_max);
+    const Measured b = measure("(b)", "perpendicular unit squares (the shooter stands on t = 0)",
+                               perpendicular_squares(), 3, options, n, error_max);
     // Both images exist in memory before either file is written.
     const Image image_a = compose(a, options), image_b = compose(b, options);
     const std::filesystem::path base(dir);

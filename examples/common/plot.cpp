@@ -311,8 +311,7 @@ void Canvas::circle(Vec2 centre, double radius, const Stroke& stroke) {
     if (!(stroke.width > 0) || !(radius >= 0)) return;
     // Coverage from the distance to the circle, ramped over one pixel like line().
     const double half = 0.5 * stroke.width;
-    const PixelRect q =
-        reach_box(centre.x, centre.x, centre.y, centre.y, radius + half + 1, clip_);
+    const PixelRect q = reach_box(centre.x, centre.x, centre.y, centre.y, radius + half + 1, clip_);
     for (int y = q.y; y < q.bottom(); ++y)
         for (int x = q.x; x < q.right(); ++x) {
             const Vec2 off = Vec2{x + 0.5, y + 0.5} - centre;
@@ -716,11 +715,11 @@ PlotLayout Plot::draw(Image& image, const PixelRect& panel) const {
     return L;
 }
 
-PlotLayout map_layout(const PixelRect& area, double x_min, double x_max, double y_min,
-                      double y_max, int text_scale) {
+PlotLayout map_layout(const PixelRect& area, double x_min, double x_max, double y_min, double y_max,
+                      int text_scale) {
     MBR_CHECK_MSG(area.w > 0 && area.h > 0 && x_max > x_min && y_max > y_min,
-                  "area " << area.w << " x " << area.h << ", x " << x_min << ".." << x_max
-                          << ", y " << y_min << ".." << y_max);
+                  "area " << area.w << " x " << area.h << ", x " << x_min << ".." << x_max << ", y "
+                          << y_min << ".." << y_max);
     const int s = text_scale;
     PlotLayout L;
     L.area = area;
@@ -912,7 +911,8 @@ void draw_colour_scale(Image& image, const PixelRect& bar, double v_min, double 
                         Align::centre);
         }
     }
-    if (!caption.empty()) canvas.text(bar.x, bar.y - 1 - gap, caption, ink, s, Align::start, Align::end);
+    if (!caption.empty())
+        canvas.text(bar.x, bar.y - 1 - gap, caption, ink, s, Align::start, Align::end);
 }
 
 void blit(Image& dst, const Image& src, int x, int y) {
