@@ -19,15 +19,17 @@
 // above E are drawn black and counted. --error-max E fixes it instead (E = 1 / magnification).
 // Expect with the defaults: (a) rea about 0.0033 % (max 0.018 %, at the middle of the edges
 // s = 0 and s = 1), full red at 0.02 % (magnification 5000); (b) rea about 0.33 % (max about
-// 32 %), the error concentrated near the shared edge t = 0 and worst at its ends, where the
-// form factor's derivatives are singular; full red at 5 % (magnification 20), 0.6 % of the
-// points beyond. Configuration (a) is symmetric under s <-> t, so its error image should be
-// too: horizontal bands that vertical ones do not mirror point at the pipeline (they come from
-// project() dropping sub-cells of coarse leaves whose t-range misses the fulcrum; with that
-// fixed, rea falls to 0.0011 % and the picture becomes symmetric).
+// 32 % at (0.998, 0.014)), the error concentrated along the side edges s = 0 and s = 1 below
+// t = 0.2, worst at the ends of the shared edge t = 0, where the form factor's derivatives are
+// singular; full red at 5 % (magnification 20), 370 points (0.56 %) beyond, drawn black.
+// Configuration (a) is symmetric under s <-> t, so its error image should be too: horizontal
+// bands that vertical ones do not mirror point at the pipeline (they come from project()
+// dropping sub-cells of coarse leaves whose t-range misses the fulcrum; with that fixed, rea
+// falls to 0.0011 % and the picture becomes symmetric).
 // stdout: per image the configuration, rea, max relative error and where, the colour ranges
 // and the file written. A bad option or a missing directory gives one error line and exit 2;
-// both images are rendered before either is written, and each file is written atomically.
+// both images are rendered before either is written, each file is written atomically, and
+// if the second cannot be written the first is removed again.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -160,22 +162,25 @@ Image compose(const Measured& M, const ReceiverOptions& options) {
     const int width = 2 * panel_w + pad;
 
     // Header: what is shown, under which options, wrapped to the image width.
-    const std::string title =
-        "Figure 7" + M.label + ": " + M.geometry + ", d = " + std::to_string(M.depth);
+    const std::vector<std::string> title =
+        wrap_text("Figure 7" + M.label + ": " + M.geometry + ", d = " + std::to_string(M.depth),
+                  width - 2 * pad, 3);
     const std::vector<std::string> subtitle = wrap_text(
         "Relative error of a single energy transfer (shooter radiosity 1, reflectance 1); " +
             describe(options) + "; sample points: the " + std::to_string(M.n) + " x " +
             std::to_string(M.n) + " cell centres of [0,1]^2.",
         width - 2 * pad, s);
+    const int title_lines_h = int(title.size()) * glyph_line_height * 3;
     const int header_h =
-        pad / 2 + glyph_line_height * 3 + int(subtitle.size()) * glyph_line_height * s + pad;
+        pad / 2 + title_lines_h + int(subtitle.size()) * glyph_line_height * s + pad;
     Image image(width, header_h + 2 * panel_h + pad / 2, {1, 1, 1});
     Canvas canvas(image);
     const Rgb ink{0, 0, 0};
-    canvas.text(pad, pad / 2, title, ink, 3);
+    for (size_t i = 0; i < title.size(); ++i)
+        canvas.text(pad, pad / 2 + int(i) * glyph_line_height * 3, title[i], ink, 3);
     for (size_t i = 0; i < subtitle.size(); ++i)
-        canvas.text(pad, pad / 2 + glyph_line_height * 3 + int(i) * glyph_line_height * s,
-                    subtitle[i], ink, s);
+        canvas.text(pad, pad / 2 + title_lines_h + int(i) * glyph_line_height * s, subtitle[i], ink,
+                    s);
 
     auto field_area = [&](int column, int row) {
         return PixelRect{column * panel_w + pad + margin, header_h + row * panel_h + title_h, area,
@@ -287,7 +292,7 @@ int run(Args& args) {
 
     const Measured a = measure("(a)", "parallel unit squares, h = 0.5", parallel_squares(0.5), 4,
                                options, n, error_max);
-    const Measured b = measure("(b)", "perpendicular unit squares (the shooter stands on t = 0)",
+    const Measured b = measure("(b)", "perpendicular unit squares, shared edge t = 0",
                                perpendicular_squares(), 3, options, n, error_max);
     // Both images exist in memory before either file is written.
     const Image image_a = compose(a, options), image_b = compose(b, options);
