@@ -276,6 +276,79 @@ TEST_CASE("plot: scalar fields, colour bars and blit", "[plot]") {
     CHECK(dst.at(2, 3) == Rgb{1, 0, 0});
 }
 
+TEST_CASE("plot: wrap_text keeps every word, in order, within the width", "[plot]") {
+    const std::string text = "the quick brown fox jumps over the lazy dog\nnext one";
+    const int max_width = text_width("the quick brown", 2);
+    const std::vector<std::string> lines = wrap_text(text, max_width, 2);
+    std::string joined;
+    for (const std::string& line : lines) {
+        CAPTURE(line);
+        CHECK(text_width(line, 2) <= max_width);
+        joined += (joined.empty() ? "" : " ") + line;
+    }
+    CHECK(joined == "the quick brown fox jumps over the lazy dog next one");
+    CHECK(lines.front() == "the quick brown");
+    CHECK(lines.back() == "next one");  // the newline starts a line
+    // A word longer than the width gets a line of its own, unbroken.
+    const std::vector<std::string> long_word = wrap_text("a abcdefghij b", text_width("abc", 1), 1);
+    REQUIRE(long_word.size() == 3);
+    CHECK(long_word[1] == "abcdefghij");
+}
+
+TEST_CASE("plot: circles are outlines; concentric ones stay apart", "[plot]") {
+    Image img(40, 40, {1, 1, 1});
+    Canvas canvas(img);
+    const Vec2 c{20, 20};
+    canvas.circle(c, 6, {{0, 0, 0}, 2});
+    canvas.circle(c, 13, {{0, 0, 0}, 2});
+    // Coverage ramps over one pixel: a pixel whose centre is 0.52 px from the circle is 98 %
+    // covered by a 2 px stroke.
+    auto dark = [](Rgb c) { return max_abs(c) < 0.05; };
+    CHECK(is_white(img.at(20, 20)));  // the centre stays empty
+    CHECK(dark(img.at(26, 19)));      // on the inner circle (pixel centre 6.52 px out)
+    CHECK(dark(img.at(19, 33)));      // on the outer circle (13.51 px out, below the centre)
+    CHECK(is_white(img.at(29, 19)));  // between the two, 9.5 px out
+    CHECK(is_white(img.at(0, 0)));    // outside both
+}
+
+TEST_CASE("plot: map_layout and draw_axes frame a hand-drawn area without touching it", "[plot]") {
+    Image img(300, 260, {1, 1, 1});
+    const PixelRect area{80, 20, 200, 160};
+    const PlotLayout L = map_layout(area, -1, 3, 0, 1, 1);
+    const Vec2 lower_left = L.to_pixel(-1, 0), upper_right = L.to_pixel(3, 1);
+    CHECK(lower_left.x == Approx(area.x));
+    CHECK(lower_left.y == Approx(area.bottom()));
+    CHECK(upper_right.x == Approx(area.right()));
+    CHECK(upper_right.y == Approx(area.y));
+    REQUIRE(L.x_ticks.size() >= 2);
+    for (double t : L.x_ticks) CHECK((t >= -1 && t <= 3));
+    CHECK(is_nice(L.x_step));
+    draw_axes(img, L, "s", "a long y label", {0, 0, 0}, 1);
+    bool untouched = true;
+    for (int y = area.y; y < area.bottom(); ++y)
+        for (int x = area.x; x < area.right(); ++x) untouched = untouched && is_white(img.at(x, y));
+    CHECK(untouched);
+    CHECK(is_black(img.at(area.x - 1, area.y + 50)));  // the frame, just outside
+    CHECK(is_black(img.at(area.x + 50, area.bottom() + 1)));
+    CHECK(axes_margin(1) > 0);
+}
+
+TEST_CASE("plot: a colour scale runs from map(0) to map(1), log scales by decades", "[plot]") {
+    for (bool log : {false, true}) {
+        CAPTURE(log);
+        Image img(300, 120, {1, 1, 1});
+        const PixelRect bar{20, 30, 256, 20};
+        draw_colour_scale(img, bar, log ? 1e-8 : 0.0, 1, "caption", colour_map, 1, log);
+        auto close = [](Rgb a, Rgb b) { return max_abs(a - b) < 0.01; };
+        CHECK(close(img.at(bar.x, bar.y + 10), colour_map(0.5 / bar.w)));
+        CHECK(close(img.at(bar.right() - 1, bar.y + 10), colour_map(1 - 0.5 / bar.w)));
+        // The middle of the bar: 0.5 on the linear scale, 1e-4 on the log one.
+        CHECK(close(img.at(bar.x + 128, bar.y + 10), colour_map(128.5 / 256)));
+    }
+    Image img(100, 100, {1, 1, 1});
+    CHECK_THROWS(draw_colour_scale(img, {10, 10, 50, 10}, 0, 1, "", colour_map, 1, true));
+}
+
 // === Plot
 
 TEST_CASE("plot: layout maps the data ranges onto the plot area", "[plot]") {

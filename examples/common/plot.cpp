@@ -160,6 +160,32 @@ int text_width(const std::string& s, int scale) {
     return scale * (glyph_advance * static_cast<int>(s.size()) - (glyph_advance - glyph_width));
 }
 
+std::vector<std::string> wrap_text(const std::string& s, int max_width, int scale) {
+    std::vector<std::string> lines;
+    size_t start = 0;
+    while (start <= s.size()) {
+        const size_t newline = std::min(s.find('\n', start), s.size());
+        const std::string paragraph = s.substr(start, newline - start);
+        std::string line;
+        size_t i = 0;
+        while (i < paragraph.size()) {
+            const size_t space = std::min(paragraph.find(' ', i), paragraph.size());
+            const std::string word = paragraph.substr(i, space - i);
+            const std::string joined = line.empty() ? word : line + " " + word;
+            if (!line.empty() && text_width(joined, scale) > max_width) {
+                lines.push_back(line);
+                line = word;
+            } else {
+                line = joined;
+            }
+            i = space + 1;
+        }
+        lines.push_back(line);
+        start = newline + 1;
+    }
+    return lines;
+}
+
 // === Canvas
 
 namespace {
@@ -278,6 +304,20 @@ void Canvas::disc(Vec2 centre, double radius, Rgb c) {
             const Vec2 off = Vec2{x + 0.5, y + 0.5} - centre;
             const double cov = std::clamp(radius + 0.5 - std::sqrt(dot(off, off)), 0.0, 1.0);
             if (cov > 0) blend(x, y, c, cov);
+        }
+}
+
+void Canvas::circle(Vec2 centre, double radius, const Stroke& stroke) {
+    if (!(stroke.width > 0) || !(radius >= 0)) return;
+    // Coverage from the distance to the circle, ramped over one pixel like line().
+    const double half = 0.5 * stroke.width;
+    const PixelRect q = reach_box(centre.x, centre.x, centre.y, centre.y, radius + half + 1, clip_);
+    for (int y = q.y; y < q.bottom(); ++y)
+        for (int x = q.x; x < q.right(); ++x) {
+            const Vec2 off = Vec2{x + 0.5, y + 0.5} - centre;
+            const double d = std::fabs(std::sqrt(dot(off, off)) - radius);
+            const double cov = std::clamp(half + 0.5 - d, 0.0, 1.0);
+            if (cov > 0) blend(x, y, stroke.colour, cov);
         }
 }
 
@@ -675,6 +715,65 @@ PlotLayout Plot::draw(Image& image, const PixelRect& panel) const {
     return L;
 }
 
+PlotLayout map_layout(const PixelRect& area, double x_min, double x_max, double y_min, double y_max,
+                      int text_scale) {
+    MBR_CHECK_MSG(area.w > 0 && area.h > 0 && x_max > x_min && y_max > y_min,
+                  "area " << area.w << " x " << area.h << ", x " << x_min << ".." << x_max << ", y "
+                          << y_min << ".." << y_max);
+    const int s = text_scale;
+    PlotLayout L;
+    L.area = area;
+    L.x_min = x_min, L.x_max = x_max, L.y_min = y_min, L.y_max = y_max;
+    const AxisTicks xt = axis_ticks(
+        x_min, x_max, false, area.w, std::max(2, area.w / (35 * s)),
+        [&](double v, double step) { return text_width(tick_label(v, step), s); },
+        4 * glyph_advance * s);
+    const AxisTicks yt = axis_ticks(
+        y_min, y_max, false, area.h, std::max(2, area.h / (35 * s)),
+        [&](double, double) { return glyph_height * s; }, 3 * glyph_height * s / 2);
+    L.x_ticks = xt.ticks, L.x_step = xt.step;
+    L.y_ticks = yt.ticks, L.y_step = yt.step;
+    return L;
+}
+
+void draw_axes(Image& image, const PlotLayout& L, const std::string& x_label,
+               const std::string& y_label, Rgb foreground, int text_scale) {
+    Canvas canvas(image);
+    const PixelRect& a = L.area;
+    const int s = text_scale, line = glyph_line_height * s, gap = 4 * s, tick_len = 3 * s;
+    canvas.stroke_rect({a.x - 2, a.y - 2, a.w + 4, a.h + 4}, foreground, 2);
+    for (double x : L.x_ticks) {
+        const int px = static_cast<int>(std::lround(L.to_pixel(x, L.y_min).x));
+        canvas.fill_rect({px - 1, a.bottom() + 2, 2, tick_len}, foreground);
+        canvas.text(px, a.bottom() + 2 + tick_len + gap, axis_label(x, L.x_step, L.log_x),
+                    foreground, s, Align::centre, Align::start);
+    }
+    int widest_y = 0;
+    for (double y : L.y_ticks) {
+        const int py = static_cast<int>(std::lround(L.to_pixel(L.x_min, y).y));
+        const std::string label = axis_label(y, L.y_step, L.log_y);
+        widest_y = std::max(widest_y, text_width(label, s));
+        canvas.fill_rect({a.x - 2 - tick_len, py - 1, tick_len, 2}, foreground);
+        canvas.text(a.x - 2 - tick_len - gap, py, label, foreground, s, Align::end, Align::centre);
+    }
+    if (!x_label.empty())
+        canvas.text(a.x + a.w / 2, a.bottom() + 2 + tick_len + gap + line + gap / 2, x_label,
+                    foreground, s, Align::centre, Align::start);
+    if (y_label.size() > 3)
+        canvas.text(a.x - 2 - tick_len - gap - widest_y - gap - glyph_height * s, a.y + a.h / 2,
+                    y_label, foreground, s, Align::centre, Align::start, true);
+    else if (!y_label.empty())
+        canvas.text(a.x - 2 - tick_len - gap - widest_y - 2 * gap, a.y + a.h / 2, y_label,
+                    foreground, s, Align::end, Align::centre);
+}
+
+int axes_margin(int text_scale, int label_chars) {
+    const int s = text_scale, line = glyph_line_height * s, gap = 4 * s, tick_len = 3 * s;
+    const int left = 2 + tick_len + gap + label_chars * glyph_advance * s + gap + line;
+    const int bottom = 2 + tick_len + gap + line + gap / 2 + line;
+    return std::max(left, bottom);
+}
+
 // === Colour maps and images of scalars
 
 namespace {
@@ -767,6 +866,53 @@ void draw_colour_bar(Image& image, const PixelRect& r, double v_min, double v_ma
         canvas.text(r.right(), ty, bar_label(v_max), ink, s, Align::end);
         if (!caption.empty()) canvas.text(r.x + r.w / 2, ty, caption, ink, s, Align::centre);
     }
+}
+
+void draw_colour_scale(Image& image, const PixelRect& bar, double v_min, double v_max,
+                       const std::string& caption, ColourMapFn map, int text_scale, bool log) {
+    MBR_CHECK_MSG(v_max > v_min && (!log || v_min > 0),
+                  "colour scale " << v_min << ".." << v_max << (log ? " (log)" : ""));
+    Canvas canvas(image);
+    const int s = text_scale, gap = 3 * s, tick_len = 3 * s;
+    const Rgb ink{0, 0, 0};
+    const bool horizontal = bar.w >= bar.h;
+    const double t0 = log ? std::log10(v_min) : v_min, t1 = log ? std::log10(v_max) : v_max;
+    // The bar: colour by position, v_min at the left (horizontal) or bottom (vertical).
+    const int length = horizontal ? bar.w : bar.h;
+    for (int p = 0; p < length; ++p) {
+        const Rgb c = map(length > 1 ? (p + 0.5) / length : 0.5);
+        if (horizontal)
+            canvas.fill_rect({bar.x + p, bar.y, 1, bar.h}, c);
+        else
+            canvas.fill_rect({bar.x, bar.bottom() - 1 - p, bar.w, 1}, c);
+    }
+    canvas.stroke_rect({bar.x - 1, bar.y - 1, bar.w + 2, bar.h + 2}, ink, 1);
+    // Ticks spaced so that their labels do not touch.
+    const AxisTicks ticks =
+        horizontal
+            ? axis_ticks(
+                  t0, t1, log, bar.w, std::max(2, bar.w / (40 * s)),
+                  [&](double v, double step) { return text_width(axis_label(v, step, log), s); },
+                  3 * glyph_advance * s)
+            : axis_ticks(
+                  t0, t1, log, bar.h, std::max(2, bar.h / (30 * s)),
+                  [&](double, double) { return glyph_height * s; }, glyph_height * s);
+    for (double v : ticks.ticks) {
+        const double t = ((log ? std::log10(v) : v) - t0) / (t1 - t0);
+        const std::string label = axis_label(v, ticks.step, log);
+        if (horizontal) {
+            const int px = bar.x + static_cast<int>(std::lround(t * (bar.w - 1)));
+            canvas.fill_rect({px - s / 2, bar.bottom() + 1, std::max(1, s), tick_len}, ink);
+            canvas.text(px, bar.bottom() + 1 + tick_len + gap, label, ink, s, Align::centre);
+        } else {
+            const int py = bar.bottom() - 1 - static_cast<int>(std::lround(t * (bar.h - 1)));
+            canvas.fill_rect({bar.right() + 1, py - s / 2, tick_len, std::max(1, s)}, ink);
+            canvas.text(bar.right() + 1 + tick_len + gap, py, label, ink, s, Align::start,
+                        Align::centre);
+        }
+    }
+    if (!caption.empty())
+        canvas.text(bar.x, bar.y - 1 - gap, caption, ink, s, Align::start, Align::end);
 }
 
 void blit(Image& dst, const Image& src, int x, int y) {

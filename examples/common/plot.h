@@ -45,6 +45,9 @@ bool has_glyph(char c);
 Glyph glyph(char c);
 /// Width in pixels of s drawn at the given scale (no trailing gap).
 int text_width(const std::string& s, int scale);
+/// s broken at spaces into lines no wider than max_width pixels at the given scale (a word
+/// longer than a line gets a line of its own); existing newlines are kept.
+std::vector<std::string> wrap_text(const std::string& s, int max_width, int scale);
 
 // === Canvas
 
@@ -90,6 +93,9 @@ public:
     void polyline(const std::vector<Vec2>& points, const Stroke& stroke);
     /// A filled, anti-aliased disc (plot markers).
     void disc(Vec2 centre, double radius, Rgb c);
+    /// An anti-aliased circle outline of the given radius (to the middle of the stroke); the
+    /// stroke's dash pattern is ignored. Concentric circles of different radii stay apart.
+    void circle(Vec2 centre, double radius, const Stroke& stroke);
     /// Text at an integer scale, anchored at (x, y): h_align picks left/centre/right of the
     /// text, v_align top/middle/bottom of the cap height (bottom = baseline). vertical = true
     /// rotates it a quarter turn anticlockwise, to read bottom to top (y-axis labels); the
@@ -188,6 +194,21 @@ private:
     std::vector<VLine> vlines_;
 };
 
+/// A data rectangle [x_min, x_max] x [y_min, y_max] mapped onto the pixel rectangle `area`
+/// (y up), with nice ticks sized for labels at `text_scale`: the frame of a picture drawn by
+/// hand (maps of the (s,t) plane, images of fields), to be finished by draw_axes.
+PlotLayout map_layout(const PixelRect& area, double x_min, double x_max, double y_min,
+                      double y_max, int text_scale = 2);
+/// The frame around a layout's area (just outside it), with outward ticks, their labels and the
+/// axis labels below and to the left, as Plot::draw draws them (a y label of up to three
+/// characters stays upright, a longer one is turned to read upwards). Leave about
+/// axes_margin(text_scale) pixels free on the left and below the area.
+void draw_axes(Image& image, const PlotLayout& layout, const std::string& x_label,
+               const std::string& y_label, Rgb foreground = {0, 0, 0}, int text_scale = 2);
+/// The margin, in pixels, that draw_axes needs left of and below the area for tick labels of
+/// up to `label_chars` characters and one axis label.
+int axes_margin(int text_scale = 2, int label_chars = 4);
+
 // === Colour maps and images of scalars
 
 /// A perceptually ordered sequential map for t in [0, 1] (clamped; NaN gives mid grey):
@@ -213,6 +234,13 @@ void draw_scalar_field(Image& image, const PixelRect& r, const std::vector<doubl
 void draw_colour_bar(Image& image, const PixelRect& r, double v_min, double v_max,
                      const std::string& caption = "", ColourMapFn map = colour_map,
                      int text_scale = 2);
+/// A colour scale: the bar fills `bar` exactly; ticks at nice values (whole decades when `log`,
+/// which needs 0 < v_min < v_max) are labelled below a horizontal bar or right of a vertical
+/// one, and the caption goes above the bar. The caller leaves room for the labels (about
+/// 3 glyph lines below, or six characters to the right) and one line for the caption above.
+void draw_colour_scale(Image& image, const PixelRect& bar, double v_min, double v_max,
+                       const std::string& caption, ColourMapFn map = colour_map,
+                       int text_scale = 2, bool log = false);
 /// Copies src into dst with its top-left corner at (x, y); parts outside dst are dropped.
 void blit(Image& dst, const Image& src, int x, int y);
 
