@@ -17,15 +17,12 @@
 // E is a 1-2-5 value: by default the smallest one at or above the 99th percentile of the
 // errors, so that a few points at a singular corner cannot wash the picture out; points
 // above E are drawn black and counted. --error-max E fixes it instead (E = 1 / magnification).
-// Expect with the defaults: (a) rea about 0.0033 % (max 0.018 %, at the middle of the edges
-// s = 0 and s = 1), full red at 0.02 % (magnification 5000); (b) rea about 0.33 % (max about
-// 32 % at (0.998, 0.014)), the error concentrated along the side edges s = 0 and s = 1 below
-// t = 0.2, worst at the ends of the shared edge t = 0, where the form factor's derivatives are
-// singular; full red at 5 % (magnification 20), 370 points (0.56 %) beyond, drawn black.
-// Configuration (a) is symmetric under s <-> t, so its error image should be too: horizontal
-// bands that vertical ones do not mirror point at the pipeline (they come from project()
-// dropping sub-cells of coarse leaves whose t-range misses the fulcrum; with that fixed, rea
-// falls to 0.0011 % and the picture becomes symmetric).
+// Expect with the defaults: (a) rea about 0.0011 % (max about 0.008 %, near the corners),
+// full red at 0.005 % (magnification 20000), a pattern symmetric under s <-> t as the
+// configuration is; (b) rea about 0.32 % (max about 32 % at (0.998, 0.014)), the error
+// concentrated along the side edges s = 0 and s = 1 below t = 0.2, worst at the ends of the
+// shared edge t = 0, where the form factor's derivatives are singular; full red at 5 %
+// (magnification 20), about 380 points (0.58 %) beyond, drawn black.
 // stdout: per image the configuration, rea, max relative error and where, the colour ranges
 // and the file written. A bad option or a missing directory gives one error line and exit 2;
 // both images are rendered before either is written, each file is written atomically, and
