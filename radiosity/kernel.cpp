@@ -134,7 +134,9 @@ IncrementIntegrator::Result IncrementIntegrator::integrate(const SurfacePoint& p
         opt.tolerance = 0.25 * tolerance;
         opt.max_depth = std::max(0, options_.max_depth - 1);
         opt.min_share = 4 * options_.min_share;
-        auto cell_rule = [&](const QuadCell& cell, int n) { return sum_over(p, points(global(cell), n)); };
+        auto cell_rule = [&](const QuadCell& cell, int n) {
+            return sum_over(p, points(global(cell), n));
+        };
         const Rect quadrant{0.5 * qi, 0.5 * (qi + 1), 0.5 * qj, 0.5 * (qj + 1)};
         auto r = adaptive_tensor_rule_2d(cell_rule, quadrant, opt, keep_partition);
         result.value += r.value;

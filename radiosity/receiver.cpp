@@ -674,7 +674,8 @@ Rgb project(const ReceiverState& state, const DualTable& dn, const Fulcrum& f) {
             // rounding; the exact test follows.
             const double dx = std::max({0.0, strip.x0 - centre.x, centre.x - strip.x1});
             const double reach = R - dx;
-            const int q0 = std::max(0, static_cast<int>(std::floor((centre.y - reach - r.y0) / h)) - 1);
+            const int q0 =
+                std::max(0, static_cast<int>(std::floor((centre.y - reach - r.y0) / h)) - 1);
             const int q1 = std::min(n_sub - 1, static_cast<int>(std::floor((centre.y + reach - r.y0) / h)));
             for (int q = q0; q <= q1; ++q) {
                 const Rect sub{strip.x0, strip.x1, r.y0 + q * h, r.y0 + (q + 1) * h};
