@@ -76,10 +76,9 @@ double parallel_plates(double a, double b, double c) {
 /// rectangles with a common edge"), H = h/l, W = w/l.
 double perpendicular_plates(double l, double h, double w) {
     const double H = h / l, W = w / l, H2 = H * H, W2 = W * W, R = std::sqrt(H2 + W2);
-    const double log_term =
-        std::log((1 + W2) * (1 + H2) / (1 + W2 + H2)) +
-        W2 * std::log(W2 * (1 + W2 + H2) / ((1 + W2) * (W2 + H2))) +
-        H2 * std::log(H2 * (1 + H2 + W2) / ((1 + H2) * (H2 + W2)));
+    const double log_term = std::log((1 + W2) * (1 + H2) / (1 + W2 + H2)) +
+                            W2 * std::log(W2 * (1 + W2 + H2) / ((1 + W2) * (W2 + H2))) +
+                            H2 * std::log(H2 * (1 + H2 + W2) / ((1 + H2) * (H2 + W2)));
     return (W * std::atan(1 / W) + H * std::atan(1 / H) - R * std::atan(1 / R) + 0.25 * log_term) /
            (Pi * W);
 }
@@ -90,7 +89,9 @@ double closed_form_parallel(double s, double t, double h) {
 }
 double closed_form_perpendicular(double s, double t) {
     // Shooter x in [0,1], z in [0,1] in y = 0; the point (s, t, 0) is at distance t from it.
-    auto P = [&](double x) { return x == 0 ? 0.0 : (x > 0 ? 1 : -1) * perpendicular_corner(std::fabs(x), 1, t); };
+    auto P = [&](double x) {
+        return x == 0 ? 0.0 : (x > 0 ? 1 : -1) * perpendicular_corner(std::fabs(x), 1, t);
+    };
     return P(1 - s) - P(-s);
 }
 
@@ -109,7 +110,8 @@ Shooter unit_shooter(const Surface& surface) {
 /// int over [0,1]^2 of F(p, x(u,v)) B(u,v) A(u,v) du dv by an n x n Gauss-Legendre rule on each
 /// cell of a cells x cells grid: the brute-force reference for (21).
 template <class B>
-double brute_force_increment(const SurfacePoint& p, const Surface& shooter, B&& b, int cells, int n) {
+double brute_force_increment(const SurfacePoint& p, const Surface& shooter, B&& b, int cells,
+                             int n) {
     const GaussLegendre rule = gauss_legendre(n);
     double sum = 0;
     for (int ci = 0; ci < cells; ++ci)
@@ -168,7 +170,8 @@ TEST_CASE("kernel: F is symmetric, non-negative and zero behind either surface",
     CHECK(form_factor_kernel({0, 0, 0}, {0, 0, 1}, {1, 0, 0}, {0, 0, -1}) == 0);
 }
 
-TEST_CASE("kernel: analytic form factor equals the closed form for a parallel rectangle", "[kernel]") {
+TEST_CASE("kernel: analytic form factor equals the closed form for a parallel rectangle",
+          "[kernel]") {
     // The element's normal through a corner; then any point under or beside the rectangle by
     // signed superposition of four corner rectangles.
     std::mt19937 rng(2);
@@ -200,7 +203,8 @@ TEST_CASE("kernel: analytic form factor equals the closed form for a parallel re
     }
 }
 
-TEST_CASE("kernel: analytic form factor equals the closed form for a perpendicular rectangle", "[kernel]") {
+TEST_CASE("kernel: analytic form factor equals the closed form for a perpendicular rectangle",
+          "[kernel]") {
     std::mt19937 rng(3);
     std::uniform_real_distribution<double> side(0.05, 3), unit(0.001, 1);
     for (int trial = 0; trial < 300; ++trial) {
@@ -241,7 +245,8 @@ TEST_CASE("kernel: analytic form factor is one-sided and clips at the tangent pl
     }
 }
 
-TEST_CASE("kernel: analytic form factor equals brute-force quadrature of F over tilted quads", "[kernel]") {
+TEST_CASE("kernel: analytic form factor equals brute-force quadrature of F over tilted quads",
+          "[kernel]") {
     // Random planar parallelograms in front of a random point: Lambert's contour integral
     // against 16 x 16 cells of 8 x 8 Gauss-Legendre points of eq. (3) times the area factor.
     // The point stays at least 0.5 from the quad, so the integrand is smooth on the scale of
@@ -254,13 +259,16 @@ TEST_CASE("kernel: analytic form factor equals brute-force quadrature of F over 
             e2{u(rng), u(rng), 0.3 * u(rng)};
         const Surface quad = Surface::planar_quad(o, o + e1, o + e1 + e2, o + e2);
         const Vec3 n = quad.normal(0.5, 0.5);
-        const SurfacePoint p{{0.1 * u(rng), 0.1 * u(rng), 0}, normalize(Vec3{0.3 * u(rng), 0.3 * u(rng), 1}), 1};
+        const SurfacePoint p{
+            {0.1 * u(rng), 0.1 * u(rng), 0}, normalize(Vec3{0.3 * u(rng), 0.3 * u(rng), 1}), 1};
         if (dot(o - p.position, n) >= 0) continue;  // the quad must face the point
         if (length(cross(e1, e2)) < 0.2) continue;  // not a sliver
         ++tested;
         CAPTURE(trial, o, e1, e2, p.normal);
-        const double exact = point_polygon_form_factor(p.position, p.normal, {o, o + e1, o + e1 + e2, o + e2});
-        const double brute = brute_force_increment(p, quad, [](double, double) { return 1.0; }, 16, 8);
+        const double exact =
+            point_polygon_form_factor(p.position, p.normal, {o, o + e1, o + e1 + e2, o + e2});
+        const double brute = brute_force_increment(
+            p, quad, [](double, double) { return 1.0; }, 16, 8);
         CHECK(brute == Approx(exact).epsilon(1e-10));
     }
     CHECK(tested >= 10);
@@ -288,10 +296,11 @@ TEST_CASE("kernel: grid means of the exact values match the area form factors", 
         double exact;
         bool smooth;
     };
-    const Config configs[] = {{"h = 1.0", parallel_squares(1.0), parallel_plates(1, 1, 1.0), true},
-                              {"h = 0.5", parallel_squares(0.5), parallel_plates(1, 1, 0.5), true},
-                              {"h = 0.1", parallel_squares(0.1), parallel_plates(1, 1, 0.1), true},
-                              {"perpendicular", perpendicular_squares(), perpendicular_plates(1, 1, 1), false}};
+    const Config configs[] = {
+        {"h = 1.0", parallel_squares(1.0), parallel_plates(1, 1, 1.0), true},
+        {"h = 0.5", parallel_squares(0.5), parallel_plates(1, 1, 0.5), true},
+        {"h = 0.1", parallel_squares(0.1), parallel_plates(1, 1, 0.1), true},
+        {"perpendicular", perpendicular_squares(), perpendicular_plates(1, 1, 1), false}};
     for (const Config& c : configs) {
         CAPTURE(c.name);
         const std::vector<double> grid = exact_grid(c.setup, n);
@@ -305,7 +314,9 @@ TEST_CASE("kernel: grid means of the exact values match the area form factors", 
             // central differences of the analytic F (smooth across the edges of the receiver,
             // whose plane extends beyond them) and Gauss-Legendre along each edge.
             const std::vector<Vec3> poly = c.setup.shooter_polygon();
-            auto F = [&](double s, double t) { return point_polygon_form_factor({s, t, 0}, {0, 0, 1}, poly); };
+            auto F = [&](double s, double t) {
+                return point_polygon_form_factor({s, t, 0}, {0, 0, 1}, poly);
+            };
             const double d = 1e-5;
             const GaussLegendre rule = gauss_legendre(20);
             double flux = 0;
@@ -314,10 +325,14 @@ TEST_CASE("kernel: grid means of the exact values match the area form factors", 
                     flux += integrate_1d(
                         [&](double x) {
                             switch (e) {
-                                case 0: return -(F(x, d) - F(x, -d)) / (2 * d);       // t = 0, outward -t
-                                case 1: return (F(1 + d, x) - F(1 - d, x)) / (2 * d);  // s = 1
-                                case 2: return (F(x, 1 + d) - F(x, 1 - d)) / (2 * d);  // t = 1
-                                default: return -(F(d, x) - F(-d, x)) / (2 * d);      // s = 0
+                                case 0:
+                                    return -(F(x, d) - F(x, -d)) / (2 * d);  // t = 0, outward -t
+                                case 1:
+                                    return (F(1 + d, x) - F(1 - d, x)) / (2 * d);  // s = 1
+                                case 2:
+                                    return (F(x, 1 + d) - F(x, 1 - d)) / (2 * d);  // t = 1
+                                default:
+                                    return -(F(d, x) - F(-d, x)) / (2 * d);  // s = 0
                             }
                         },
                         q / 10.0, (q + 1) / 10.0, rule);
@@ -356,7 +371,8 @@ TEST_CASE("kernel: adaptive quadrature of (21) matches the analytic form factor"
         const Shooter shooter = unit_shooter(c.setup.shooter);
         IncrementIntegrator integrator(shooter, options);
         const std::vector<Vec3> polygon = c.setup.shooter_polygon();
-        std::vector<Vec2> points{{0.5, 0.5}, {0, 0}, {1, 1}, {0.5, 0}, {0.001, 0.999}, {0.3, 1e-3}, {0.7, 1e-5}};
+        std::vector<Vec2> points{{0.5, 0.5},     {0, 0},      {1, 1},     {0.5, 0},
+                                 {0.001, 0.999}, {0.3, 1e-3}, {0.7, 1e-5}};
         for (int i = 0; i < 25; ++i) points.push_back({unit(rng), unit(rng)});
         double worst = 0, sum = 0;
         int counted = 0;
@@ -414,12 +430,14 @@ TEST_CASE("kernel: integrate_on its own partition gives integrate's value", "[ke
     }
 }
 
-TEST_CASE("kernel: quadrature of (21) weights the shooter's radiosity and area factor", "[kernel]") {
+TEST_CASE("kernel: quadrature of (21) weights the shooter's radiosity and area factor",
+          "[kernel]") {
     // A tilted 2 x 0.5 rectangle (area factor 1, not the unit square's) above the origin, and a
     // non-constant unshot field B_h(u,v) = u exactly (Greville: sum_k (k + m/2) 2^-j N_m(2^j u - k)
     // = u). Reference: 16 x 16 cells of 8 x 8 Gauss-Legendre points of F B A (smooth integrand:
     // the shooter is at distance >= 0.8, so this is exact to ~1e-13).
-    const Surface quad = Surface::planar_quad({-1, -0.25, 1}, {-1, 0.25, 1}, {1, 0.25, 0.8}, {1, -0.25, 0.8});
+    const Surface quad =
+        Surface::planar_quad({-1, -0.25, 1}, {-1, 0.25, 1}, {1, 0.25, 0.8}, {1, -0.25, 0.8});
     REQUIRE(quad.area_factor(0.3, 0.3) == Approx(std::sqrt(4 + 0.04) * 0.5).epsilon(1e-14));
     const int m = 4, j = 1;
     SplineField ramp(m, j);
@@ -434,15 +452,18 @@ TEST_CASE("kernel: quadrature of (21) weights the shooter's radiosity and area f
     shooter.surface = &quad;
     shooter.unshot = ramp;
     IncrementIntegrator integrator(shooter, QuadratureOptions{});
-    const std::vector<Vec3> polygon{quad.corners()[0], quad.corners()[1], quad.corners()[2], quad.corners()[3]};
+    const std::vector<Vec3> polygon{quad.corners()[0], quad.corners()[1], quad.corners()[2],
+                                    quad.corners()[3]};
     std::mt19937 rng(8);
     std::uniform_real_distribution<double> u(-0.5, 0.5);
     for (int trial = 0; trial < 8; ++trial) {
-        const SurfacePoint p{{u(rng), u(rng), 0}, normalize(Vec3{0.2 * u(rng), 0.2 * u(rng), 1}), 1};
+        const SurfacePoint p{
+            {u(rng), u(rng), 0}, normalize(Vec3{0.2 * u(rng), 0.2 * u(rng), 1}), 1};
         CAPTURE(trial, p.position, p.normal);
-        const double brute = brute_force_increment(p, quad, [](double a, double) { return a; }, 16, 8);
+        const double brute = brute_force_increment(
+            p, quad, [](double a, double) { return a; }, 16, 8);
         const IncrementIntegrator::Result r = integrator.integrate(p);
-        CHECK(r.value.r == Approx(brute).epsilon(1e-5));  // 1e-4 asked; see the test above
+        CHECK(r.value.r == Approx(brute).epsilon(1e-5));           // 1e-4 asked; see the test above
         CHECK(r.value.g == Approx(2 * r.value.r).epsilon(1e-14));  // channels are independent
         CHECK(r.value.b == Approx(3 * r.value.r).epsilon(1e-14));
     }

@@ -40,7 +40,8 @@ void split_at_random(Forest& forest, std::mt19937& rng, int n_splits, int max_le
         for (int index : forest.leaves())
             if (forest.node(index).cell.level < max_level) candidates.push_back(index);
         if (candidates.empty()) return;
-        forest.split(candidates[std::uniform_int_distribution<size_t>(0, candidates.size() - 1)(rng)]);
+        forest.split(
+            candidates[std::uniform_int_distribution<size_t>(0, candidates.size() - 1)(rng)]);
     }
 }
 
@@ -89,7 +90,8 @@ void balance_brute_force(Forest& forest) {
 
 }  // namespace
 
-TEST_CASE("quadtree: dyadic cells have the documented rectangle, parent and children", "[quadtree]") {
+TEST_CASE("quadtree: dyadic cells have the documented rectangle, parent and children",
+          "[quadtree]") {
     const DyadicCell c{3, -5, 6};
     CHECK(c.size() == 0.125);
     const Rect r = c.rect();
@@ -118,15 +120,16 @@ TEST_CASE("quadtree: dyadic cells have the documented rectangle, parent and chil
     CHECK_FALSE(DyadicCell{0, 1, 1}.in_domain());
 }
 
-TEST_CASE("quadtree: patches 0..7 run counter-clockwise from below-left of the domain", "[quadtree]") {
+TEST_CASE("quadtree: patches 0..7 run counter-clockwise from below-left of the domain",
+          "[quadtree]") {
     // Figure 5 as documented in quadtree.h: 0 (s<0,t<0), 1 below, 2 (s>1,t<0), 3 right,
     // 4 (s>1,t>1), 5 above, 6 (s<0,t>1), 7 left; -1 for the domain itself.
     struct Expect {
         double s, t;
         int patch;
     };
-    const Expect expect[] = {{-0.3, -0.2, 0}, {0.5, -0.7, 1}, {1.4, -0.1, 2}, {1.2, 0.5, 3},
-                             {1.9, 1.3, 4},   {0.1, 1.6, 5},  {-0.6, 1.1, 6}, {-0.2, 0.99, 7},
+    const Expect expect[] = {{-0.3, -0.2, 0}, {0.5, -0.7, 1},  {1.4, -0.1, 2}, {1.2, 0.5, 3},
+                             {1.9, 1.3, 4},   {0.1, 1.6, 5},   {-0.6, 1.1, 6}, {-0.2, 0.99, 7},
                              {0.5, 0.5, -1},  {0.01, 0.99, -1}};
     for (int level = 0; level <= 4; ++level)
         for (const Expect& e : expect) {
@@ -278,7 +281,8 @@ TEST_CASE("quadtree: leaf_at returns the leaf whose half-open cell holds the poi
     CHECK(forest.leaf_at(0.5, 2.0001) == -1);
 }
 
-TEST_CASE("quadtree: after scale adjustment no leaf is more than twice any neighbour", "[quadtree]") {
+TEST_CASE("quadtree: after scale adjustment no leaf is more than twice any neighbour",
+          "[quadtree]") {
     // Random forests (seeded): domain alone (K = 0) checked over the domain, and a forest with
     // the ring (K = 1) checked everywhere. Neighbours are the leaves whose closed rectangles
     // touch: the edge and corner neighbours of Figure 4, found by brute force.
@@ -354,8 +358,8 @@ TEST_CASE("quadtree: scale adjustment leaves a balanced forest alone", "[quadtre
         // the level-1 quadrants touching that level-3 block must split, nothing else.
         Forest forest(0);
         const int q = forest.split(forest.domain_root());  // level 1
-        const int c = forest.split(q);                      // quadrant (0,0) -> level 2
-        forest.split(c + 3);                                // cell (1,1) of level 2 -> level 3
+        const int c = forest.split(q);                     // quadrant (0,0) -> level 2
+        forest.split(c + 3);                               // cell (1,1) of level 2 -> level 3
         // (1,1) at level 2 spans [0.25, 0.5]^2: its level-3 children touch quadrants (1,0),
         // (0,1) and (1,1) of level 1 (edges and a corner), which are two levels coarser.
         // Before: those three are unbalanced w.r.t. the level-3 cells.

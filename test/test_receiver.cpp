@@ -84,7 +84,8 @@ void build_ring(ReceiverState& state, int far_level) {
         const DyadicCell c = forest.node(index).cell;
         double h_touch = 0;
         for (const Rect& b : boundary)
-            if (touching(c.rect(), b)) h_touch = h_touch == 0 ? b.width() : std::min(h_touch, b.width());
+            if (touching(c.rect(), b))
+                h_touch = h_touch == 0 ? b.width() : std::min(h_touch, b.width());
         if ((h_touch > 0 && c.size() > h_touch) || c.level < far_level) {
             const int first = forest.split(index);
             for (int ch = 0; ch < 4; ++ch) work.push_back(first + ch);
@@ -111,7 +112,8 @@ void fill_samples(ReceiverState& state, F&& f) {
                 const double v = f(r.x0 + 0.5 * (rule.x[a] + 1) * r.width(),
                                    r.y0 + 0.5 * (rule.x[b] + 1) * r.height());
                 state.samples.push_back({v, -2 * v, 0.5 * v});
-                if (node.cell.in_domain()) state.max_sample = std::max(state.max_sample, 2 * std::fabs(v));
+                if (node.cell.in_domain())
+                    state.max_sample = std::max(state.max_sample, 2 * std::fabs(v));
             }
     }
 }
@@ -179,7 +181,8 @@ double projection_error_bound(const DualTable& dn, double r, double h, double c,
         D[q] = std::fabs(dn(0.5 * m + x[q]));
     }
     // g_i(x) = (h|x| + c)^i |D(x)| for x = +-x_q; tail_i[q] = sum over |y| >= x_q of g_i(y) delta.
-    std::vector<std::vector<double>> g(m, std::vector<double>(N)), tail(m, std::vector<double>(N + 1, 0.0));
+    std::vector<std::vector<double>> g(m, std::vector<double>(N)),
+        tail(m, std::vector<double>(N + 1, 0.0));
     for (int i = 0; i < m; ++i) {
         for (int q = 0; q < N; ++q) g[i][q] = std::pow(h * x[q] + c, i) * D[q];
         for (int q = N - 1; q >= 0; --q) tail[i][q] = tail[i][q + 1] + 2 * g[i][q] * delta;
@@ -223,7 +226,8 @@ std::vector<double> fulcrum_reach(const ReceiverState& state) {
 /// reaches into the domain) are selected but never refined into the result, because every leaf
 /// near the domain is at least that fine; leaving them out makes the bound stricter, never
 /// looser.
-double field_error_bound(const ReceiverState& state, const DualTable& dn, const std::vector<double>& abs_a) {
+double field_error_bound(const ReceiverState& state, const DualTable& dn,
+                         const std::vector<double>& abs_a) {
     const std::vector<double> reach = fulcrum_reach(state);
     int min_level = 64;
     for (int index : state.forest.leaves(Forest::Region::Domain))
@@ -231,8 +235,9 @@ double field_error_bound(const ReceiverState& state, const DualTable& dn, const 
     double bound = 0;
     for (int level = min_level; level < int(reach.size()); ++level)
         if (reach[level] >= 0)
-            bound = std::max(bound, projection_error_bound(dn, state.rhombus_radius, std::ldexp(1.0, -level),
-                                                           reach[level], abs_a, state.options.m));
+            bound = std::max(
+                bound, projection_error_bound(dn, state.rhombus_radius, std::ldexp(1.0, -level),
+                                              reach[level], abs_a, state.options.m));
     return bound;
 }
 
@@ -292,13 +297,15 @@ double polynomial_error(const Poly& p, bool mixed, double eps, double* bound) {
     mbr::test::report() << "receiver polynomial m=" << m << (mixed ? " mixed  " : " uniform")
                         << " eps=" << eps << ": rhombus " << state.rhombus_radius
                         << " cells, max error " << error << ", bound " << *bound << ", fulcrums "
-                        << state.fulcrums.size() << ", refined by (17) " << state.stats.n_refined << "\n";
+                        << state.fulcrums.size() << ", refined by (17) " << state.stats.n_refined
+                        << "\n";
     return error;
 }
 
 }  // namespace
 
-TEST_CASE("receiver: projection reproduces polynomials of degree < m up to truncation", "[receiver]") {
+TEST_CASE("receiver: projection reproduces polynomials of degree < m up to truncation",
+          "[receiver]") {
     // Random p of degree m - 1 in each variable, extended exactly outside the domain, with the
     // default eps = 1e-7. The only error is the truncation of the dual: the bound is the
     // dropped tail of |p DN DN| (projection_error_bound). p grows like |x|^(2m-2) while DN DN
@@ -334,7 +341,8 @@ TEST_CASE("receiver: polynomial reproduction error is truncation alone", "[recei
     }
 }
 
-TEST_CASE("receiver: projecting a function of the spline space returns its coefficients", "[receiver]") {
+TEST_CASE("receiver: projecting a function of the spline space returns its coefficients",
+          "[receiver]") {
     // f = sum c_kl N_m(4s - k) N_m(4t - l) with random c in [-1,1] over the whole forest
     // (domain and ring), sampled at every leaf's Gauss-Legendre nodes; every leaf is at level
     // >= 2, so f is one polynomial per leaf and the quadrature of f DN DN is exact. Uniform
@@ -375,14 +383,16 @@ TEST_CASE("receiver: projecting a function of the spline space returns its coeff
                 }
             CAPTURE(worst, bound);
             CHECK(worst <= bound);
-            mbr::test::report() << "receiver spline space m=" << m << (mixed ? " mixed  " : " uniform")
-                                << ": max coefficient error " << worst << ", bound " << bound << "\n";
+            mbr::test::report() << "receiver spline space m=" << m
+                                << (mixed ? " mixed  " : " uniform") << ": max coefficient error "
+                                << worst << ", bound " << bound << "\n";
         }
 }
 
 // ---- The rhombus (section 5 "Projection", Figure 3) -----------------------------------------
 
-TEST_CASE("receiver: the rhombus holds every point where |DN DN| exceeds eps, and little more", "[receiver]") {
+TEST_CASE("receiver: the rhombus holds every point where |DN DN| exceeds eps, and little more",
+          "[receiver]") {
     for (int m = 2; m <= 5; ++m)
         for (double eps : {1e-4, 1e-7, 1e-10}) {
             CAPTURE(m, eps);
@@ -395,7 +405,9 @@ TEST_CASE("receiver: the rhombus holds every point where |DN DN| exceeds eps, an
             options.rhombus_radius = 7.25;  // an explicit radius wins
             CHECK(rhombus_radius_cells(options, dn) == 7.25);
             const double threshold = eps * dn.max_abs() * dn.max_abs();
-            auto DD = [&](double x, double y) { return std::fabs(dn(0.5 * m + x) * dn(0.5 * m + y)); };
+            auto DD = [&](double x, double y) {
+                return std::fabs(dn(0.5 * m + x) * dn(0.5 * m + y));
+            };
             // Outside: on the boundary |x| + |y| = r + d for d in (0, 3], every 1/64 along it.
             double outside = 0, inside = 0;
             for (double d : {1e-9, 0.01, 0.5, 1.0, 3.0})
@@ -564,29 +576,48 @@ std::set<Spot> paper_rule(const Forest& forest, int m, double unit) {
             points.push_back(r.centre());
         else
             points = {{r.x0, r.y0}, {r.x1, r.y0}, {r.x0, r.y1}, {r.x1, r.y1}};
-        for (const Vec2& p : points) out.insert({c.level, int(std::lround(p.x / unit)), int(std::lround(p.y / unit))});
+        for (const Vec2& p : points)
+            out.insert({c.level, int(std::lround(p.x / unit)), int(std::lround(p.y / unit))});
     }
     return out;
 }
 
 }  // namespace
 
-TEST_CASE("receiver: fulcrums for m = 3 on a hand-built tree equal the hand-listed set", "[receiver]") {
+TEST_CASE("receiver: fulcrums for m = 3 on a hand-built tree equal the hand-listed set",
+          "[receiver]") {
     // Centres (units of 1/8) of: the domain's level-2 leaves (2,0,0) (2,1,0) (2,0,1) (2,1,1) and
     // level-1 leaves (1,1,0) (1,0,1) (1,1,1); the level-2 ring leaves adjoining the domain,
     // (2,-1,j) for j = -1..3 and (2,i,-1) for i = 0..3; the level-1 ring leaves adjoining it,
     // (1,-1,2) (1,2,-1) (1,2,0) (1,2,1) (1,2,2) (1,0,2) (1,1,2). The other expanded leaves have
     // centres whose N_3 (support: the cell and one on each side) misses the domain.
-    const std::set<Spot> expect{
-        // domain, level 2
-        {2, 1, 1}, {2, 3, 1}, {2, 1, 3}, {2, 3, 3},
-        // domain, level 1
-        {1, 6, 2}, {1, 2, 6}, {1, 6, 6},
-        // ring, level 2
-        {2, -1, -1}, {2, -1, 1}, {2, -1, 3}, {2, -1, 5}, {2, -1, 7},
-        {2, 1, -1}, {2, 3, -1}, {2, 5, -1}, {2, 7, -1},
-        // ring, level 1
-        {1, -2, 10}, {1, 10, -2}, {1, 10, 2}, {1, 10, 6}, {1, 10, 10}, {1, 2, 10}, {1, 6, 10}};
+    const std::set<Spot> expect{// domain, level 2
+                                {2, 1, 1},
+                                {2, 3, 1},
+                                {2, 1, 3},
+                                {2, 3, 3},
+                                // domain, level 1
+                                {1, 6, 2},
+                                {1, 2, 6},
+                                {1, 6, 6},
+                                // ring, level 2
+                                {2, -1, -1},
+                                {2, -1, 1},
+                                {2, -1, 3},
+                                {2, -1, 5},
+                                {2, -1, 7},
+                                {2, 1, -1},
+                                {2, 3, -1},
+                                {2, 5, -1},
+                                {2, 7, -1},
+                                // ring, level 1
+                                {1, -2, 10},
+                                {1, 10, -2},
+                                {1, 10, 2},
+                                {1, 10, 6},
+                                {1, 10, 10},
+                                {1, 2, 10},
+                                {1, 6, 10}};
     REQUIRE(expect.size() == 23);
     const Forest forest = fulcrum_tree();
     const std::vector<Fulcrum> fulcrums = select_fulcrums(forest, 3);
@@ -598,7 +629,8 @@ TEST_CASE("receiver: fulcrums for m = 3 on a hand-built tree equal the hand-list
     CHECK(std::count(fulcrums.begin(), fulcrums.end(), Fulcrum{1, 0, 0}) == 1);   // cell (1,1,1)
 }
 
-TEST_CASE("receiver: fulcrums for m = 4 on a hand-built tree equal the hand-listed set", "[receiver]") {
+TEST_CASE("receiver: fulcrums for m = 4 on a hand-built tree equal the hand-listed set",
+          "[receiver]") {
     // Corners (units of 1/4) of the same tree. Level 2: the corners of the four level-2 domain
     // leaves, {0,1,2}^2, and of the level-2 ring leaves adjoining the domain: x in {-1,0} with
     // y in -1..4, and y in {-1,0} with x in -1..4. Level 1: the corners of the three level-1
@@ -615,10 +647,11 @@ TEST_CASE("receiver: fulcrums for m = 4 on a hand-built tree equal the hand-list
     const std::set<Spot> paper_level2 = expect;
     REQUIRE(paper_level2.size() == 24);
     // Level 1, written out: 19 points.
-    const Spot level1[] = {{1, 2, 0}, {1, 4, 0}, {1, 0, 2}, {1, 2, 2}, {1, 4, 2}, {1, 0, 4}, {1, 2, 4},
-                           {1, 4, 4},  // the domain leaves' corners
-                           {1, 4, -2}, {1, 6, -2}, {1, 6, 0}, {1, 6, 2}, {1, 6, 4}, {1, 6, 6}, {1, 4, 6},
-                           {1, 2, 6}, {1, 0, 6}, {1, -2, 6}, {1, -2, 4}};  // the adjoining ring leaves'
+    const Spot level1[] = {
+        {1, 2, 0},  {1, 4, 0},  {1, 0, 2}, {1, 2, 2},  {1, 4, 2}, {1, 0, 4},
+        {1, 2, 4},  {1, 4, 4},  // the domain leaves' corners
+        {1, 4, -2}, {1, 6, -2}, {1, 6, 0}, {1, 6, 2},  {1, 6, 4}, {1, 6, 6},
+        {1, 4, 6},  {1, 2, 6},  {1, 0, 6}, {1, -2, 6}, {1, -2, 4}};  // the adjoining ring leaves'
     for (const Spot& s : level1) expect.insert(s);
     REQUIRE(expect.size() == 43);
     const Forest forest = fulcrum_tree();
@@ -680,7 +713,8 @@ TEST_CASE("receiver: the extra fulcrums of select_fulcrums change no coefficient
     REQUIRE(without.level() == with_extras.level());
     const int first = first_touching_index(m), n = touching_count(m, without.level());
     for (int k = first; k < first + n; ++k)
-        for (int l = first; l < first + n; ++l) CHECK(without.coefficient(k, l) == with_extras.coefficient(k, l));
+        for (int l = first; l < first + n; ++l)
+            CHECK(without.coefficient(k, l) == with_extras.coefficient(k, l));
 }
 
 // ---- Extrapolation, eqs. (23)-(27) ----------------------------------------------------------
@@ -688,9 +722,15 @@ TEST_CASE("receiver: the extra fulcrums of select_fulcrums change no coefficient
 namespace {
 
 /// A smooth stand-in for dB near the domain and its partial derivatives.
-double g(double s, double t) { return 0.6 + 0.3 * s - 0.2 * t + 0.15 * s * t + 0.05 * s * s; }
-double g_s(double s, double t) { return 0.3 + 0.15 * t + 0.1 * s; }
-double g_t(double s, double) { return -0.2 + 0.15 * s; }
+double g(double s, double t) {
+    return 0.6 + 0.3 * s - 0.2 * t + 0.15 * s * t + 0.05 * s * s;
+}
+double g_s(double s, double t) {
+    return 0.3 + 0.15 * t + 0.1 * s;
+}
+double g_t(double s, double) {
+    return -0.2 + 0.15 * s;
+}
 
 /// Edge profiles of g at nine nodes per edge (h_min = 1/4), as fill_boundary would leave them:
 /// values on the edge and the derivative along the edge's normal coordinate (t on the bottom
@@ -719,10 +759,14 @@ ReceiverState extrapolation_state(Extrapolation kind) {
 /// The point at distance x outside edge e at edge parameter sigma.
 Vec2 outside(int e, double sigma, double x) {
     switch (e) {
-        case 0: return {sigma, -x};
-        case 1: return {1 + x, sigma};
-        case 2: return {sigma, 1 + x};
-        default: return {-x, sigma};
+        case 0:
+            return {sigma, -x};
+        case 1:
+            return {1 + x, sigma};
+        case 2:
+            return {sigma, 1 + x};
+        default:
+            return {-x, sigma};
     }
 }
 
@@ -753,7 +797,8 @@ TEST_CASE("receiver: edge profiles interpolate linearly between edgefill nodes",
     CHECK(d.r == 4);
 }
 
-TEST_CASE("receiver: linear extrapolation (23)-(25) continues value and slope of each edge", "[receiver]") {
+TEST_CASE("receiver: linear extrapolation (23)-(25) continues value and slope of each edge",
+          "[receiver]") {
     const ReceiverState state = extrapolation_state(Extrapolation::Linear);
     for (int e = 0; e < 4; ++e)
         for (double sigma : {0.0, 0.1, 0.5, 0.8125, 1.0}) {
@@ -769,7 +814,8 @@ TEST_CASE("receiver: linear extrapolation (23)-(25) continues value and slope of
             if (sigma > 0 && sigma < 1) {  // on the side patches (the corner ones use both)
                 const double sign = e == 0 || e == 3 ? -1.0 : 1.0;
                 const double slope = (extrapolated(state, outside(e, sigma, 0.7)) -
-                                      extrapolated(state, outside(e, sigma, 0.2))) / (sign * 0.5);
+                                      extrapolated(state, outside(e, sigma, 0.2))) /
+                                     (sign * 0.5);
                 CHECK(slope == Approx(d.r).epsilon(1e-12));
             }
         }
@@ -778,17 +824,25 @@ TEST_CASE("receiver: linear extrapolation (23)-(25) continues value and slope of
     for (double a : {0.01, 0.3, 1.7})
         for (double b : {0.02, 0.9}) {
             CAPTURE(a, b);
-            CHECK(extrapolated(state, {-a, -b}) == Approx(g(0, 0) - a * g_s(0, 0) - b * g_t(0, 0)).epsilon(1e-13));
-            CHECK(extrapolated(state, {1 + a, -b}) == Approx(g(1, 0) + a * g_s(1, 0) - b * g_t(1, 0)).epsilon(1e-13));
-            CHECK(extrapolated(state, {1 + a, 1 + b}) == Approx(g(1, 1) + a * g_s(1, 1) + b * g_t(1, 1)).epsilon(1e-13));
-            CHECK(extrapolated(state, {-a, 1 + b}) == Approx(g(0, 1) - a * g_s(0, 1) + b * g_t(0, 1)).epsilon(1e-13));
+            CHECK(extrapolated(state, {-a, -b}) ==
+                  Approx(g(0, 0) - a * g_s(0, 0) - b * g_t(0, 0)).epsilon(1e-13));
+            CHECK(extrapolated(state, {1 + a, -b}) ==
+                  Approx(g(1, 0) + a * g_s(1, 0) - b * g_t(1, 0)).epsilon(1e-13));
+            CHECK(extrapolated(state, {1 + a, 1 + b}) ==
+                  Approx(g(1, 1) + a * g_s(1, 1) + b * g_t(1, 1)).epsilon(1e-13));
+            CHECK(extrapolated(state, {-a, 1 + b}) ==
+                  Approx(g(0, 1) - a * g_s(0, 1) + b * g_t(0, 1)).epsilon(1e-13));
             // Continuity across the lines that separate corner and side patches (the profiles
             // agree at the corners, as edgefill's do: both sample the same corner points).
             const double z = 1e-12;
-            CHECK(extrapolated(state, {-z, -b}) == Approx(extrapolated(state, {z, -b})).margin(1e-11));
-            CHECK(extrapolated(state, {-a, -z}) == Approx(extrapolated(state, {-a, z})).margin(1e-11));
-            CHECK(extrapolated(state, {1 + a, 1 - z}) == Approx(extrapolated(state, {1 + a, 1 + z})).margin(1e-11));
-            CHECK(extrapolated(state, {1 - z, 1 + b}) == Approx(extrapolated(state, {1 + z, 1 + b})).margin(1e-11));
+            CHECK(extrapolated(state, {-z, -b}) ==
+                  Approx(extrapolated(state, {z, -b})).margin(1e-11));
+            CHECK(extrapolated(state, {-a, -z}) ==
+                  Approx(extrapolated(state, {-a, z})).margin(1e-11));
+            CHECK(extrapolated(state, {1 + a, 1 - z}) ==
+                  Approx(extrapolated(state, {1 + a, 1 + z})).margin(1e-11));
+            CHECK(extrapolated(state, {1 - z, 1 + b}) ==
+                  Approx(extrapolated(state, {1 + z, 1 + b})).margin(1e-11));
         }
 }
 
@@ -825,18 +879,21 @@ TEST_CASE("receiver: higher-order extrapolation meets (26) and (27)", "[receiver
                 CAPTURE(int(kind), e, sigma);
                 Rgb v, d;
                 state.edges[e].at(sigma, v, d);
-                const double inward = e == 0 || e == 3 ? 1.0 : -1.0;  // normal coordinate grows inwards
+                const double inward =
+                    e == 0 || e == 3 ? 1.0 : -1.0;  // normal coordinate grows inwards
                 auto f = [&](double x) { return extrapolated(state, outside(e, sigma, x)); };
                 // At the edge: value and derivative (d/dx outward = -inward * d).
                 CHECK(f(1e-13) == Approx(v.r).margin(1e-11));
                 CHECK((f(delta) - f(1e-13)) / delta == Approx(-inward * d.r).margin(tol));
                 // Zero from `reach` cells on, with zero derivative arriving there.
-                for (double x : {reach * w, reach * w + 1e-9, reach * w + 0.1, 3.0}) CHECK(f(x) == 0);
+                for (double x : {reach * w, reach * w + 1e-9, reach * w + 0.1, 3.0})
+                    CHECK(f(x) == 0);
                 CHECK((f(reach * w) - f(reach * w - delta)) / delta == Approx(0).margin(tol));
                 CHECK(f(reach * w - 0.05) != 0);
                 if (kind == Extrapolation::Quadratic) {
                     // C^1 at one cell out: one-sided derivatives agree, the values too.
-                    const double left = (f(w) - f(w - delta)) / delta, right = (f(w + delta) - f(w)) / delta;
+                    const double left = (f(w) - f(w - delta)) / delta,
+                                 right = (f(w + delta) - f(w)) / delta;
                     CHECK(left == Approx(right).margin(2 * tol));
                     CHECK(f(w - 1e-12) == Approx(f(w + 1e-12)).margin(1e-10));
                 }
@@ -866,7 +923,9 @@ Run run_transfer(const TransferSetup& setup, const ReceiverOptions& options) {
     Run run{setup, {}, {}};
     const SplineField unshot = SplineField::constant(options.m, 0, {1, 1, 1});
     const Shooter shooter = make_shooter(run.setup.shooter, unshot, options.shooter_coarsening);
-    const ReceiverSurface receiver{&run.setup.receiver, [](double, double) { return Rgb{1, 1, 1}; }};
+    const ReceiverSurface receiver{&run.setup.receiver, [](double, double) {
+                                       return Rgb{1, 1, 1};
+                                   }};
     run.field = transfer(shooter, receiver, options, nullptr, &run.state);
     return run;
 }
@@ -930,9 +989,12 @@ TEST_CASE("receiver: transfer leaves each stage's result in a consistent state",
         const Rect r = node.cell.rect();
         for (int a = 0; a < m; ++a)
             for (int b = 0; b < m; ++b) {
-                const double s = r.x0 + 0.5 * (rule.x[a] + 1) * r.width(), t = r.y0 + 0.5 * (rule.x[b] + 1) * r.height();
+                const double s = r.x0 + 0.5 * (rule.x[a] + 1) * r.width(),
+                             t = r.y0 + 0.5 * (rule.x[b] + 1) * r.height();
                 const double F = exact(s, t);
-                worst_sample = std::max(worst_sample, std::fabs(st.samples[size_t(node.samples) * m * m + a * m + b].r - F) / F);
+                worst_sample = std::max(
+                    worst_sample,
+                    std::fabs(st.samples[size_t(node.samples) * m * m + a * m + b].r - F) / F);
             }
     }
     CHECK(worst_sample <= 1e-4);
@@ -979,7 +1041,8 @@ TEST_CASE("receiver: transfer leaves each stage's result in a consistent state",
     double h_coarse = 0;
     for (int index : domain) {
         const Rect r = forest.node(index).cell.rect();
-        if (r.x0 == 0 || r.y0 == 0 || r.x1 == 1 || r.y1 == 1) h_coarse = std::max(h_coarse, r.width());
+        if (r.x0 == 0 || r.y0 == 0 || r.x1 == 1 || r.y1 == 1)
+            h_coarse = std::max(h_coarse, r.width());
     }
     CHECK(forest.extent() >= (st.rhombus_radius + m + 1) * h_coarse);
     for (int a : near) {
@@ -998,14 +1061,17 @@ TEST_CASE("receiver: transfer leaves each stage's result in a consistent state",
     CHECK(st.stats.n_fulcrums == int(st.fulcrums.size()));
     CHECK(run.field.level() == finest);
     CHECK(st.stats.level == finest);
-    mbr::test::report() << "receiver transfer state: " << domain.size() << " domain leaves (depth <= " << finest
-                        << "), " << st.stats.n_expanded_leaves << " expanded, ring K = " << forest.extent()
-                        << ", worst sample error " << worst_sample << ", edge values " << worst_value
-                        << " (corners " << worst_corner << "), edge derivatives " << worst_derivative / largest_derivative << " of max "
-                        << largest_derivative << "\n";
+    mbr::test::report() << "receiver transfer state: " << domain.size()
+                        << " domain leaves (depth <= " << finest << "), "
+                        << st.stats.n_expanded_leaves << " expanded, ring K = " << forest.extent()
+                        << ", worst sample error " << worst_sample << ", edge values "
+                        << worst_value << " (corners " << worst_corner << "), edge derivatives "
+                        << worst_derivative / largest_derivative << " of max " << largest_derivative
+                        << "\n";
 }
 
-TEST_CASE("receiver: uniform trees keep the expanded cells next to the domain at the leaves' size", "[receiver]") {
+TEST_CASE("receiver: uniform trees keep the expanded cells next to the domain at the leaves' size",
+          "[receiver]") {
     // Section 6, "Scale Adjustment": "the scale of boundary subdomains in R[a,b;c,d] [must] be
     // equal to that of its neighboring expanded subdomains".
     const Run run = run_transfer(parallel_squares(1.0), uniform_options(3));
@@ -1018,7 +1084,8 @@ TEST_CASE("receiver: uniform trees keep the expanded cells next to the domain at
         CHECK(c.level == 3);
     }
     CHECK(touching_leaves == 4 * 8 + 4);
-    for (int index : forest.leaves(Forest::Region::Domain)) CHECK(forest.node(index).cell.level == 3);
+    for (int index : forest.leaves(Forest::Region::Domain))
+        CHECK(forest.node(index).cell.level == 3);
 }
 
 TEST_CASE("receiver: results do not depend on the number of threads", "[receiver]") {
@@ -1037,7 +1104,8 @@ TEST_CASE("receiver: results do not depend on the number of threads", "[receiver
     const Run two = run_transfer(perpendicular_squares(), options);
     omp_set_num_threads(saved);
     REQUIRE(one.field.level() == two.field.level());
-    const int first = first_touching_index(options.m), n = touching_count(options.m, one.field.level());
+    const int first = first_touching_index(options.m),
+              n = touching_count(options.m, one.field.level());
     int differ = 0;
     for (int k = first; k < first + n; ++k)
         for (int l = first; l < first + n; ++l)
@@ -1057,8 +1125,8 @@ namespace {
 /// The derivatives of order 0..m-1 at x0 of the degree m-1 polynomial through the values of
 /// `f` at the m Gauss-Legendre nodes of [a, b] (x0 = a or b), and the sums of |weights| of each
 /// (the amplification of errors in the values).
-void endpoint_derivatives(const std::function<double(double)>& f, double a, double b, double x0, int m,
-                          std::vector<double>& derivative, std::vector<double>& weight) {
+void endpoint_derivatives(const std::function<double(double)>& f, double a, double b, double x0,
+                          int m, std::vector<double>& derivative, std::vector<double>& weight) {
     const GaussLegendre rule = gauss_legendre(m);
     std::vector<double> x(m), y(m);
     for (int i = 0; i < m; ++i) {
@@ -1095,13 +1163,14 @@ void endpoint_derivatives(const std::function<double(double)>& f, double a, doub
 
 TEST_CASE("receiver: the unified field is C^(m-2) across leaves of different size", "[receiver]") {
     // Parallel squares at h = 0.1, adaptive depths 1..4 (oracle 2e-3): leaves of two sizes
-    // meet (levels 3 and 4, 32 edges between them). Along the normal through points of every edge shared by leaves of different size,
-    // the field is one polynomial of degree m - 1 on each side within one knot interval of the
-    // unified level; its one-sided derivatives at the edge, from the interpolant through m
-    // points on each side, must agree up to order m - 2. Tolerance: the classical rounding bound
-    // of (20), a convex combination of m^2 coefficients, m^2 u max|c| (u = 2^-53 ... taken as
-    // DBL_EPSILON), amplified by the interpolants' derivative weights (measured jumps are 5 %
-    // of it at most). Order m - 1 must jump somewhere by far more: the check resolves a knot.
+    // meet (levels 3 and 4, 32 edges between them). Along the normal through points of every edge
+    // shared by leaves of different size, the field is one polynomial of degree m - 1 on each side
+    // within one knot interval of the unified level; its one-sided derivatives at the edge, from
+    // the interpolant through m points on each side, must agree up to order m - 2. Tolerance: the
+    // classical rounding bound of (20), a convex combination of m^2 coefficients, m^2 u max|c| (u =
+    // 2^-53 ... taken as DBL_EPSILON), amplified by the interpolants' derivative weights (measured
+    // jumps are 5 % of it at most). Order m - 1 must jump somewhere by far more: the check resolves
+    // a knot.
     ReceiverOptions options;
     options.min_depth = 1;
     options.max_depth = 4;
@@ -1116,7 +1185,8 @@ TEST_CASE("receiver: the unified field is C^(m-2) across leaves of different siz
         for (int index : domain) levels.insert(forest.node(index).cell.level);
         REQUIRE(levels.size() >= 2);
         const double H = std::ldexp(1.0, -run.field.level());  // knot spacing of the result
-        const double noise = m * m * std::numeric_limits<double>::epsilon() * run.field.max_abs_coefficient();
+        const double noise =
+            m * m * std::numeric_limits<double>::epsilon() * run.field.max_abs_coefficient();
         int edges = 0;
         double worst_ratio = 0, largest_jump = 0, jump_tolerance = 0;
         for (int a : domain)
@@ -1125,17 +1195,22 @@ TEST_CASE("receiver: the unified field is C^(m-2) across leaves of different siz
                 if (ca.level >= cb.level) continue;  // each pair once: a coarser than b
                 const Rect ra = ca.rect(), rb = cb.rect();
                 // Shared vertical edge (s = x0) or horizontal edge (t = y0), of positive length.
-                const bool vertical = (ra.x1 == rb.x0 || rb.x1 == ra.x0) && std::min(ra.y1, rb.y1) > std::max(ra.y0, rb.y0);
-                const bool horizontal = (ra.y1 == rb.y0 || rb.y1 == ra.y0) && std::min(ra.x1, rb.x1) > std::max(ra.x0, rb.x0);
+                const bool vertical = (ra.x1 == rb.x0 || rb.x1 == ra.x0) &&
+                                      std::min(ra.y1, rb.y1) > std::max(ra.y0, rb.y0);
+                const bool horizontal = (ra.y1 == rb.y0 || rb.y1 == ra.y0) &&
+                                        std::min(ra.x1, rb.x1) > std::max(ra.x0, rb.x0);
                 if (!vertical && !horizontal) continue;
                 ++edges;
-                const double x0 = vertical ? (ra.x1 == rb.x0 ? ra.x1 : ra.x0) : (ra.y1 == rb.y0 ? ra.y1 : ra.y0);
+                const double x0 =
+                    vertical ? (ra.x1 == rb.x0 ? ra.x1 : ra.x0) : (ra.y1 == rb.y0 ? ra.y1 : ra.y0);
                 const double lo = vertical ? std::max(ra.y0, rb.y0) : std::max(ra.x0, rb.x0);
                 const double hi = vertical ? std::min(ra.y1, rb.y1) : std::min(ra.x1, rb.x1);
                 for (double frac : {0.25, 0.5, 0.8}) {
                     const double along = lo + frac * (hi - lo);
                     std::function<double(double)> f = [&](double x) {
-                        return (vertical ? run.field.evaluate(x, along) : run.field.evaluate(along, x)).r;
+                        return (vertical ? run.field.evaluate(x, along)
+                                         : run.field.evaluate(along, x))
+                            .r;
                     };
                     std::vector<double> left, right, w_left, w_right;
                     endpoint_derivatives(f, x0 - H, x0, x0, m, left, w_left);
@@ -1156,16 +1231,18 @@ TEST_CASE("receiver: the unified field is C^(m-2) across leaves of different siz
             }
         CHECK(edges > 0);
         CHECK(largest_jump > 1e3 * jump_tolerance);
-        mbr::test::report() << "receiver continuity m=" << m << ": " << domain.size() << " leaves of "
-                            << levels.size() << " sizes, " << edges << " edges between sizes, worst jump / tolerance "
-                            << worst_ratio << " (orders <= m-2), largest jump of order m-1 " << largest_jump
+        mbr::test::report() << "receiver continuity m=" << m << ": " << domain.size()
+                            << " leaves of " << levels.size() << " sizes, " << edges
+                            << " edges between sizes, worst jump / tolerance " << worst_ratio
+                            << " (orders <= m-2), largest jump of order m-1 " << largest_jump
                             << " = " << largest_jump / jump_tolerance << " tolerances\n";
     }
 }
 
 // ---- The paper's numbers (section 7, Tables 1 and 2) ----------------------------------------
 
-TEST_CASE("receiver: Table 1 row h = 1.0, d = 3 stays below the paper's 0.126 %", "[receiver][paper]") {
+TEST_CASE("receiver: Table 1 row h = 1.0, d = 3 stays below the paper's 0.126 %",
+          "[receiver][paper]") {
     // Default options (m = 4, linear extrapolation, eps = 1e-7), uniform depth 3; rea of (29)
     // on the 256 x 256 grid of cell centres. Deterministic: a plain bound.
     const Run run = run_transfer(parallel_squares(1.0), uniform_options(3));
@@ -1173,8 +1250,8 @@ TEST_CASE("receiver: Table 1 row h = 1.0, d = 3 stays below the paper's 0.126 %"
     CAPTURE(e.rea, e.max_rel);
     CHECK(e.n_points == 256 * 256);
     CHECK(e.rea < 0.126e-2);
-    mbr::test::report() << "receiver Table 1 h=1.0 d=3: rea " << 100 * e.rea << " % (paper 0.126 %), max "
-                        << 100 * e.max_rel << " %\n";
+    mbr::test::report() << "receiver Table 1 h=1.0 d=3: rea " << 100 * e.rea
+                        << " % (paper 0.126 %), max " << 100 * e.max_rel << " %\n";
 }
 
 TEST_CASE("receiver: Table 2 row d = 3 stays below the paper's 0.676 %", "[receiver][paper]") {

@@ -92,7 +92,8 @@ TEST_CASE("spline_field: a constant field is that constant everywhere", "[spline
         }
 }
 
-TEST_CASE("spline_field: evaluate is the defining sum (20) over the touching basis", "[spline_field]") {
+TEST_CASE("spline_field: evaluate is the defining sum (20) over the touching basis",
+          "[spline_field]") {
     std::mt19937 rng(2);
     for (int m = 2; m <= 5; ++m)
         for (int level : {0, 1, 3}) {
@@ -128,7 +129,8 @@ TEST_CASE("spline_field: evaluate_grid equals evaluate", "[spline_field]") {
     }
 }
 
-TEST_CASE("spline_field: refined_to keeps the function and coarsened_to takes it back", "[spline_field]") {
+TEST_CASE("spline_field: refined_to keeps the function and coarsened_to takes it back",
+          "[spline_field]") {
     std::mt19937 rng(4);
     for (int m = 2; m <= 5; ++m)
         for (int level : {0, 2}) {
@@ -180,11 +182,14 @@ TEST_CASE("spline_field: coarsening is the orthogonal projection on [0,1]^2", "[
         for (int k = first; k < first + n; k += 2)
             for (int l = first; l < first + n; l += 3) {
                 auto basis = [&](double s, double t) {
-                    return bspline(m, std::ldexp(s, j - 1) - k) * bspline(m, std::ldexp(t, j - 1) - l);
+                    return bspline(m, std::ldexp(s, j - 1) - k) *
+                           bspline(m, std::ldexp(t, j - 1) - l);
                 };
                 // Exact: on each level-j cell the integrand has degree 2m - 2 per variable.
-                const Rgb ip = integrate_cells([&](double s, double t) { return basis(s, t) * detail.evaluate(s, t); }, j, m);
-                const Rgb nf = integrate_cells([&](double s, double t) { return basis(s, t) * f.evaluate(s, t); }, j, m);
+                const Rgb ip = integrate_cells(
+                    [&](double s, double t) { return basis(s, t) * detail.evaluate(s, t); }, j, m);
+                const Rgb nf = integrate_cells(
+                    [&](double s, double t) { return basis(s, t) * f.evaluate(s, t); }, j, m);
                 worst = std::max(worst, max_abs(ip));
                 scale = std::max(scale, max_abs(nf));
             }
@@ -193,7 +198,8 @@ TEST_CASE("spline_field: coarsening is the orthogonal projection on [0,1]^2", "[
     }
 }
 
-TEST_CASE("spline_field: add of fields of different levels is the sum of their values", "[spline_field]") {
+TEST_CASE("spline_field: add of fields of different levels is the sum of their values",
+          "[spline_field]") {
     std::mt19937 rng(6);
     for (int m = 2; m <= 5; ++m) {
         CAPTURE(m);
@@ -226,12 +232,15 @@ TEST_CASE("spline_field: integrate is exact and agrees with integrate_weighted",
             CAPTURE(m, level);
             const SplineField f = random_field(m, level, rng);
             // Reference: Gauss-Legendre with m points per knot cell, exact for degree m - 1.
-            const Rgb reference = integrate_cells([&](double s, double t) { return f.evaluate(s, t); }, level, m);
+            const Rgb reference =
+                integrate_cells([&](double s, double t) { return f.evaluate(s, t); }, level, m);
             CHECK(max_diff(f.integrate(), reference) <= 1e-14);
-            CHECK(max_diff(f.integrate_weighted([](double, double) { return 1.0; }, m), reference) <= 1e-14);
+            CHECK(max_diff(f.integrate_weighted([](double, double) { return 1.0; }, m),
+                           reference) <= 1e-14);
             // A weight of degree 1 per variable: m + 1 points per cell are exact.
             auto w = [](double s, double t) { return 1 + 2 * s + 3 * t; };
-            const Rgb weighted = integrate_cells([&](double s, double t) { return w(s, t) * f.evaluate(s, t); }, level, m + 1);
+            const Rgb weighted = integrate_cells(
+                [&](double s, double t) { return w(s, t) * f.evaluate(s, t); }, level, m + 1);
             CHECK(max_diff(f.integrate_weighted(w, m + 1), weighted) <= 1e-13);
         }
 }
