@@ -11,8 +11,8 @@
 //   A = a/c, B = b/c; and a rectangle in a perpendicular plane at distance c, width a from the
 //   foot of the element along the common direction, height b along the element's normal,
 //     F = 1/(2 pi) [ atan(A) - 1/sqrt(1+B^2) atan(A/sqrt(1+B^2)) ]
-//   (derived below the helper from Lambert's contour integral, edge by edge). Other positions
-//   follow by superposition of signed corner rectangles;
+//   (derived at perpendicular_corner from Lambert's contour integral, edge by edge). Other
+//   positions follow by superposition of signed corner rectangles;
 // - the area form factors between unit squares (same catalogue: parallel plates, and
 //   perpendicular plates with a common edge), to all digits;
 // - brute-force tensor Gauss-Legendre quadrature of F over a polygon or a shooter.
@@ -61,8 +61,8 @@ double perpendicular_corner(double a, double b, double c) {
     return (std::atan(A) - std::atan(A / sb) / sb) / (2 * Pi);
 }
 
-/// Area form factor between parallel unit squares... in general X x Y rectangles at distance c
-/// facing each other (catalogue: "parallel, directly opposed rectangles").
+/// Area form factor between directly opposed parallel rectangles a x b at distance c
+/// (catalogue: "parallel, directly opposed rectangles"), X = a/c, Y = b/c.
 double parallel_plates(double a, double b, double c) {
     const double X = a / c, Y = b / c, sx = std::sqrt(1 + X * X), sy = std::sqrt(1 + Y * Y);
     return 2 / (Pi * X * Y) *
@@ -249,13 +249,14 @@ TEST_CASE("kernel: analytic form factor equals brute-force quadrature of F over 
           "[kernel]") {
     // Random planar parallelograms in front of a random point: Lambert's contour integral
     // against 16 x 16 cells of 8 x 8 Gauss-Legendre points of eq. (3) times the area factor.
-    // The point stays at least 0.5 from the quad, so the integrand is smooth on the scale of
-    // the cells (1/16 of a quad side of at most ~2): the rule converges to ~1e-13 here.
+    // The quad stays at least 0.4 above the point's plane (corner heights 1..2 minus two
+    // tilts of at most 0.3), so the integrand is smooth on the scale of the cells (1/16 of a
+    // side of at most ~1.7): the rule converges to ~1e-13 here.
     std::mt19937 rng(5);
     std::uniform_real_distribution<double> u(-1, 1);
     int tested = 0;
     for (int trial = 0; trial < 40; ++trial) {
-        const Vec3 o{u(rng), u(rng), 1.5 + u(rng)}, e1{u(rng), u(rng), 0.3 * u(rng)},
+        const Vec3 o{u(rng), u(rng), 1.5 + 0.5 * u(rng)}, e1{u(rng), u(rng), 0.3 * u(rng)},
             e2{u(rng), u(rng), 0.3 * u(rng)};
         const Surface quad = Surface::planar_quad(o, o + e1, o + e1 + e2, o + e2);
         const Vec3 n = quad.normal(0.5, 0.5);
@@ -321,7 +322,7 @@ TEST_CASE("kernel: grid means of the exact values match the area form factors", 
             const GaussLegendre rule = gauss_legendre(20);
             double flux = 0;
             for (int e = 0; e < 4; ++e)
-                for (int q = 0; q < 10; ++q)  // 10 pieces of 20 points: the edge profile has kinks
+                for (int q = 0; q < 10; ++q)  // 10 pieces of 20 points: F_n varies on scale h
                     flux += integrate_1d(
                         [&](double x) {
                             switch (e) {

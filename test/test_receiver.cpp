@@ -309,8 +309,8 @@ TEST_CASE("receiver: projection reproduces polynomials of degree < m up to trunc
     // Random p of degree m - 1 in each variable, extended exactly outside the domain, with the
     // default eps = 1e-7. The only error is the truncation of the dual: the bound is the
     // dropped tail of |p DN DN| (projection_error_bound). p grows like |x|^(2m-2) while DN DN
-    // decays geometrically, so for m = 4, 5 the error is far above eps itself (measured 1e-4
-    // and 1.3e-3 at this depth, against bounds 8e-3 and 0.4).
+    // decays geometrically, so for m = 4, 5 the error is far above eps itself (measured 9e-5
+    // and 1.8e-3 at this depth, against bounds 8e-3 and 0.4; m = 2, 3: 7e-7, 5e-7).
     std::mt19937 rng(42);
     const double eps = ReceiverOptions{}.truncation_eps;
     for (int m = 2; m <= 5; ++m)
@@ -326,7 +326,7 @@ TEST_CASE("receiver: projection reproduces polynomials of degree < m up to trunc
 
 TEST_CASE("receiver: polynomial reproduction error is truncation alone", "[receiver]") {
     // A much smaller eps (1e-11: rhombus radii 19-51 cells instead of 12-33) must shrink the
-    // error by orders of magnitude (measured factors 700-20000); anything left by the fit, the
+    // error by orders of magnitude (measured factors 360-6700); anything left by the fit, the
     // resampling, the quadrature or (17) would not shrink. Uniform trees only, to keep it fast.
     std::mt19937 rng(43);
     for (int m = 2; m <= 5; ++m) {
@@ -408,11 +408,12 @@ TEST_CASE("receiver: the rhombus holds every point where |DN DN| exceeds eps, an
             auto DD = [&](double x, double y) {
                 return std::fabs(dn(0.5 * m + x) * dn(0.5 * m + y));
             };
-            // Outside: on the boundary |x| + |y| = r + d for d in (0, 3], every 1/64 along it.
+            // Outside: on the lines |x| + |y| = r + d for d in (0, 3], 257 points along one
+            // quadrant of each (DN is symmetric).
             double outside = 0, inside = 0;
             for (double d : {1e-9, 0.01, 0.5, 1.0, 3.0})
                 for (int q = 0; q <= 64 * 4; ++q) {
-                    const double x = (r + d) * q / (64.0 * 4);  // one quadrant (DN is symmetric)
+                    const double x = (r + d) * q / (64.0 * 4);
                     outside = std::max(outside, DD(x, r + d - x));
                 }
             // Not much more: one cell inside the rhombus's edge some point exceeds eps.
