@@ -1168,10 +1168,10 @@ TEST_CASE("receiver: the unified field is C^(m-2) across leaves of different siz
     // shared by leaves of different size, the field is one polynomial of degree m - 1 on each side
     // within one knot interval of the unified level; its one-sided derivatives at the edge, from
     // the interpolant through m points on each side, must agree up to order m - 2. Tolerance: the
-    // classical rounding bound of (20), a convex combination of m^2 coefficients, m^2 u max|c| (u =
-    // 2^-53 ... taken as DBL_EPSILON), amplified by the interpolants' derivative weights (measured
-    // jumps are 5 % of it at most). Order m - 1 must jump somewhere by far more: the check resolves
-    // a knot.
+    // classical rounding bound of (20), a convex combination of m^2 coefficients, taken as
+    // m^2 DBL_EPSILON max|c|, amplified by the interpolants' derivative weights (measured jumps
+    // are 6 % of it at most). Order m - 1 must jump somewhere by far more (measured 1e10 times
+    // the tolerance): the check resolves a knot.
     ReceiverOptions options;
     options.min_depth = 1;
     options.max_depth = 4;
