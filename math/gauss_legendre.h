@@ -53,6 +53,7 @@ struct AdaptiveOptions {
     int n = 4;               // compare the n-point rule with the (n+1)-point rule
     double tolerance = 1e-8; // absolute error allowed on the whole domain
     int max_depth = 12;      // no cell is split more than this many times
+    int min_depth = 0;       // cells above this level are split whatever the rules say
     // A cell's share of the tolerance never drops below min_share * tolerance. The paper's
     // halving (quartering in 2D) otherwise asks deep cells near a singularity for agreement
     // far below rounding, which no rule can give; the bound on the accumulated error becomes
@@ -140,7 +141,8 @@ auto adaptive_tensor_rule_2d(CellRule&& cell_rule, const Rect& domain, const Ada
         result.n_evaluations += evals_per_cell;
         if (w.cell.level > result.depth) result.depth = w.cell.level;
         // A cell the caller does not trust (force_split) is split whatever the rules say.
-        bool agree = max_abs(f1 - f0) <= w.tol && !force_split(w.cell);
+        bool agree = max_abs(f1 - f0) <= w.tol && w.cell.level >= opt.min_depth &&
+                     !force_split(w.cell);
         if (agree || w.cell.level >= opt.max_depth) {
             if (!agree) result.converged = false;
             result.value += f1;

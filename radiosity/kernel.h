@@ -44,6 +44,7 @@ struct QuadratureOptions {
     int n = 6;                    // compare n x n with (n+1) x (n+1) Gauss-Legendre points
     double rel_tolerance = 1e-4;  // allowed error relative to a first estimate of the integral
     int max_depth = 24;           // cap on the shooter's subdivision (at most 28)
+    int min_depth = 1;            // the whole shooter is never accepted as one cell
     double min_share = 1e-6;      // floor of a cell's share of the tolerance (math/gauss_legendre.h)
     double near_field = 4.0;      // split a cell whose extent exceeds near_field times its
                                   //   distance from the receiving point (0: never)

@@ -681,10 +681,12 @@ Rgb project(const ReceiverState& state, const DualTable& dn, const ProjectionTab
         }
     };
 
+    // Roots [I, I+1] x [J, J+1] within the rhombus's bounding box, touching included (as in
+    // the walk below: a cell at 1-norm distance exactly R meets the closed rhombus).
     const int K = forest.extent();
-    const int I0 = std::max(-K, static_cast<int>(std::floor(centre.x - R)));
+    const int I0 = std::max(-K, static_cast<int>(std::ceil(centre.x - R)) - 1);
     const int I1 = std::min(K, static_cast<int>(std::floor(centre.x + R)));
-    const int J0 = std::max(-K, static_cast<int>(std::floor(centre.y - R)));
+    const int J0 = std::max(-K, static_cast<int>(std::ceil(centre.y - R)) - 1);
     const int J1 = std::min(K, static_cast<int>(std::floor(centre.y + R)));
     std::vector<int> stack;
     for (int J = J0; J <= J1; ++J)
@@ -717,13 +719,17 @@ Rgb project(const ReceiverState& state, const DualTable& dn, const ProjectionTab
         const double h = r.width() / n_sub;
         for (int p = 0; p < n_sub; ++p) {
             const Rect strip{r.x0 + p * h, r.x0 + (p + 1) * h, r.y0, r.y1};
-            // The strip's distance from the centre along s alone: the sub-cells of this strip
-            // within the rhombus are those with |t - cy| <= R - dx.
-            const double dx = std::max({0.0, strip.x0 - centre.x, centre.x - strip.x1});
-            if (dx > R) continue;
+            if (rhombus_distance(strip, centre) > R) continue;  // no sub-cell of it can meet
             const double* Rx = &block[size_t(p) * m * m];
+            // Sub-cells q of this strip that meet the rhombus have |t - cy| <= R - dx, with dx
+            // the distance along s alone (not the strip's 1-norm distance, which also counts
+            // the leaf's distance along t and would drop sub-cells that meet the rhombus);
+            // one row more below, so that a sub-cell touching the rhombus is not lost to
+            // rounding; the exact test follows.
+            const double dx = std::max({0.0, strip.x0 - centre.x, centre.x - strip.x1});
             const double reach = R - dx;
-            const int q0 = std::max(0, static_cast<int>(std::floor((centre.y - reach - r.y0) / h)));
+            const int q0 =
+                std::max(0, static_cast<int>(std::floor((centre.y - reach - r.y0) / h)) - 1);
             const int q1 = std::min(n_sub - 1, static_cast<int>(std::floor((centre.y + reach - r.y0) / h)));
             for (int q = q0; q <= q1; ++q) {
                 const Rect sub{strip.x0, strip.x1, r.y0 + q * h, r.y0 + (q + 1) * h};
