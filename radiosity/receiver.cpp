@@ -135,25 +135,27 @@ void subdivide_by_oracle(ReceiverState& state, IncrementSampler& sampler) {
     Forest& forest = state.forest;
     TransferStats& stats = state.stats;
 
-    // The mean of dB over a cell with an n x n rule; counts its (21) evaluations.
+    // The mean of dB over a cell with an n x n rule; counts its (21) evaluations and, when
+    // asked, keeps the largest sample.
     auto cell_mean = [&](const Rect& r, const GaussLegendre& rule, int thread, long* evals,
-                         long* increments, double* largest) {
+                         long* increments, double* largest = nullptr) {
         Rgb sum;
         double s[16], t[16];
         gauss_points(r, rule, s, t);
         for (int a = 0; a < rule.n(); ++a)
             for (int b = 0; b < rule.n(); ++b) {
                 const Rgb v = sampler.sample(s[a], t[b], thread, evals);
-                *largest = std::max(*largest, max_abs(v));
+                if (largest) *largest = std::max(*largest, max_abs(v));
                 sum += (0.25 * rule.w[a] * rule.w[b]) * v;
                 ++*increments;
             }
         return sum;
     };
 
-    // Scale for the oracle's floor: the largest of the m x m samples of the whole domain.
+    // Scale for the oracle's floor: the largest of the m x m samples of the whole domain
+    // (not needed when the bounds leave the oracle nothing to decide).
     double scale = 0;
-    {
+    if (opt.min_depth < opt.max_depth) {
         long evals = 0, increments = 0;
         cell_mean(Rect{0, 1, 0, 1}, rule_m, 0, &evals, &increments, &scale);
         stats.n_kernel_evals += evals;
@@ -167,7 +169,6 @@ void subdivide_by_oracle(ReceiverState& state, IncrementSampler& sampler) {
         const int n = static_cast<int>(frontier.size());
         std::vector<Action> action(n, Leaf);
         std::vector<long> evals(n, 0), increments(n, 0);
-        std::vector<double> largest(n, 0.0);
 #pragma omp parallel for schedule(dynamic, 1)
         for (int c = 0; c < n; ++c) {
             const DyadicCell cell = forest.node(frontier[c]).cell;
@@ -178,8 +179,8 @@ void subdivide_by_oracle(ReceiverState& state, IncrementSampler& sampler) {
             if (cell.level >= opt.max_depth) continue;  // a leaf
             // Section 6 "Oracle": ceil(m/2)^2 against m^2 Gauss-Legendre points.
             const int th = thread_id();
-            const Rgb coarse = cell_mean(cell.rect(), rule_c, th, &evals[c], &increments[c], &largest[c]);
-            const Rgb fine = cell_mean(cell.rect(), rule_m, th, &evals[c], &increments[c], &largest[c]);
+            const Rgb coarse = cell_mean(cell.rect(), rule_c, th, &evals[c], &increments[c]);
+            const Rgb fine = cell_mean(cell.rect(), rule_m, th, &evals[c], &increments[c]);
             // DESIGN: relative agreement, with a floor at 1% of the largest value in the domain
             // so that nearly dark cells do not split forever.
             const double tol = opt.oracle_tolerance * std::max(max_abs(fine), 0.01 * scale);
