@@ -343,11 +343,11 @@ void fill_boundary(ReceiverState& state, IncrementSampler& sampler) {
         const double d_tol = v_tol / profile.h_min;
 
         long evals = 0;
-        std::vector<Node> nodes{evaluate(e, 0.0, 0, &evals), evaluate(e, 1.0, 0, &evals)};
-        // Level-synchronous edgefill(a, b): segments [i, i+1] of `nodes` still to bisect.
-        std::vector<std::pair<Node, Node>> open{{nodes[0], nodes[1]}};
-        std::vector<Node> accepted_nodes = nodes;
-        for (int depth = 0; !open.empty(); ++depth) {
+        // edgefill(a, b), level by level: `open` holds the segments still to bisect, whose
+        // midpoints are evaluated in parallel; every evaluated point becomes a node.
+        std::vector<Node> accepted_nodes{evaluate(e, 0.0, 0, &evals), evaluate(e, 1.0, 0, &evals)};
+        std::vector<std::pair<Node, Node>> open{{accepted_nodes[0], accepted_nodes[1]}};
+        while (!open.empty()) {
             const int n = static_cast<int>(open.size());
             std::vector<Node> mid(n);
             std::vector<long> mid_evals(n, 0);
