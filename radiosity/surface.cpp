@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "math/check.h"
+#include "math/gauss_legendre.h"
 
 namespace mbr {
 
@@ -208,27 +209,18 @@ double Surface::area() const {
             // A planar quad's area is half the cross product of its diagonals.
             return 0.5 * length(cross(p_[2] - p_[0], p_[3] - p_[1]));
         case Kind::BilinearPatch: {
-            // No closed form in general: tensor Gauss-Legendre with 8 x 8 points on 8 x 8 cells
-            // (A is smooth; this is accurate to rounding for any reasonable patch).
-            static const double x[8] = {-0.9602898564975363, -0.7966664774136267,
-                                        -0.5255324099163290, -0.1834346424956498,
-                                        0.1834346424956498,  0.5255324099163290,
-                                        0.7966664774136267,  0.9602898564975363};
-            static const double w[8] = {0.1012285362903763, 0.2223810344533745,
-                                        0.3137066458778873, 0.3626837833783620,
-                                        0.3626837833783620, 0.3137066458778873,
-                                        0.2223810344533745, 0.1012285362903763};
+            // No closed form in general: the 8 x 8 Gauss-Legendre rule on 8 x 8 cells (A is
+            // smooth; this is accurate to rounding for any reasonable patch).
+            const GaussLegendre rule = gauss_legendre(8);
             const int cells = 8;
             double sum = 0;
             for (int ci = 0; ci < cells; ++ci)
-                for (int cj = 0; cj < cells; ++cj)
-                    for (int a = 0; a < 8; ++a)
-                        for (int b = 0; b < 8; ++b) {
-                            double u = (ci + 0.5 * (x[a] + 1)) / cells;
-                            double v = (cj + 0.5 * (x[b] + 1)) / cells;
-                            sum += w[a] * w[b] * area_factor(u, v);
-                        }
-            return sum / (4.0 * cells * cells);
+                for (int cj = 0; cj < cells; ++cj) {
+                    const Rect r{double(ci) / cells, double(ci + 1) / cells, double(cj) / cells,
+                                 double(cj + 1) / cells};
+                    sum += integrate_2d([&](double u, double v) { return area_factor(u, v); }, r, rule);
+                }
+            return sum;
         }
         case Kind::Cylinder:
             return r1_ * std::fabs(a1_ - a0_) * r0_;
