@@ -2,6 +2,8 @@
 // ray-polygon test (section 6, "Octree"); plus (u, v) interpolation for hit points.
 #include "octree/polygon.h"
 
+#include "math/convex2d.h"
+
 #include <algorithm>
 #include <cmath>
 
@@ -135,36 +137,8 @@ Vec2 Polygon::uv_at(Vec3 p) const {
 }
 
 Vec2 Polygon::uv_quad(Vec2 q) const {
-    // Inverse of the bilinear map P(s,t) = q0 + s e + t f + s t g with corners q0, q1, q2, q3 at
-    // (s,t) = (0,0), (1,0), (1,1), (0,1). Eliminating s from q - q0 - t f = s (e + t g) leaves
-    // k2 t^2 + k1 t + k0 = 0 (as in Quilez's inverse bilinear interpolation).
-    const Vec2 q0 = local_[0], q1 = local_[1], q2 = local_[2], q3 = local_[3];
-    Vec2 e = q1 - q0, f = q3 - q0, g = q0 - q1 + q2 - q3, h = q - q0;
-    double k2 = cross(g, f);
-    double k1 = cross(h, g) + cross(e, f);
-    double k0 = cross(h, e);
-    // Stable roots q_r / k2 and k0 / q_r; for a parallelogram k2 = 0 and only k0 / q_r is finite.
-    double disc = std::max(0.0, k1 * k1 - 4 * k0 * k2);  // < 0 only outside: take the vertex
-    double q_r = -0.5 * (k1 + std::copysign(std::sqrt(disc), k1));
-    double t = 0;
-    if (q_r != 0) {
-        double r1 = k0 / q_r;
-        double r2 = k2 != 0 ? q_r / k2 : HUGE_VAL;
-        // Pick the root in [0, 1], or the nearer one to that interval when extrapolating.
-        auto off = [](double r) { return r < 0 ? -r : (r > 1 ? r - 1 : 0.0); };
-        t = off(r1) <= off(r2) ? r1 : r2;
-    }
-    Vec2 d = e + t * g;
-    double s = dot(h - t * f, d) / dot(d, d);
-    // Two Newton steps on P(s,t) = q polish the rounding of the closed form.
-    for (int it = 0; it < 2; ++it) {
-        Vec2 r = q0 + s * e + t * f + (s * t) * g - q;
-        Vec2 ps = e + t * g, pt = f + s * g;
-        double det = cross(ps, pt);
-        if (det == 0) break;
-        s -= cross(r, pt) / det;
-        t -= cross(ps, r) / det;
-    }
+    const Vec2 st = inverse_bilinear(local_[0], local_[1], local_[2], local_[3], q);
+    const double s = st.x, t = st.y;
     return (1 - s) * (1 - t) * uv_[0] + s * (1 - t) * uv_[1] + s * t * uv_[2] +
            (1 - s) * t * uv_[3];
 }

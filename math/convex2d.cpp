@@ -1,0 +1,141 @@
+// math/convex2d.cpp - clipping of convex polygons and the collapsed Gauss rule on triangles.
+#include "math/convex2d.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace mbr {
+
+double signed_area(const ConvexPolygon& polygon) {
+    double a = 0;
+    const size_t n = polygon.size();
+    for (size_t i = 0; i < n; ++i) a += cross(polygon[i], polygon[(i + 1) % n]);
+    return 0.5 * a;
+}
+
+HalfPlane left_of(Vec2 a, Vec2 b) {
+    const Vec2 d = b - a;
+    const Vec2 normal{-d.y, d.x};
+    return {normal, -dot(normal, a)};
+}
+
+ConvexPolygon clip(const ConvexPolygon& polygon, const HalfPlane& h) {
+    ConvexPolygon out;
+    const size_t n = polygon.size();
+    if (n < 3) return out;
+    out.reserve(n + 1);
+    for (size_t i = 0; i < n; ++i) {
+        const Vec2 a = polygon[i], b = polygon[(i + 1) % n];
+        const double va = h.value(a), vb = h.value(b);
+        if (va >= 0) out.push_back(a);
+        // The edge crosses the line strictly: add the crossing point.
+        if ((va >= 0) != (vb >= 0) && va != vb) out.push_back(a + (va / (va - vb)) * (b - a));
+    }
+    if (out.size() < 3) out.clear();
+    return out;
+}
+
+ConvexPolygon intersect(const ConvexPolygon& a, const ConvexPolygon& b) {
+    ConvexPolygon out = a;
+    const size_t n = b.size();
+    for (size_t i = 0; i < n && !out.empty(); ++i) out = clip(out, left_of(b[i], b[(i + 1) % n]));
+    if (!out.empty() && signed_area(out) <= 0) out.clear();
+    return out;
+}
+
+std::vector<ConvexPolygon> subtract(const ConvexPolygon& a, const ConvexPolygon& b,
+                                    double min_area) {
+    std::vector<ConvexPolygon> pieces;
+    if (b.size() < 3) {
+        if (!a.empty()) pieces.push_back(a);
+        return pieces;
+    }
+    ConvexPolygon rest = a;  // the part of a still inside every edge line of b seen so far
+    const size_t n = b.size();
+    for (size_t i = 0; i < n && !rest.empty(); ++i) {
+        const HalfPlane inside = left_of(b[i], b[(i + 1) % n]);
+        const HalfPlane outside{-1.0 * inside.normal, -inside.offset};
+        ConvexPolygon piece = clip(rest, outside);
+        if (!piece.empty() && signed_area(piece) > min_area) pieces.push_back(std::move(piece));
+        rest = clip(rest, inside);
+    }
+    // What is left of a lies inside b: removed.
+    return pieces;
+}
+
+Overlap classify(const ConvexPolygon& a, const ConvexPolygon& b) {
+    if (a.size() < 3 || b.size() < 3) return Overlap::disjoint;
+    // Separating axis: an edge line of either polygon with the other wholly outside it.
+    bool a_inside_b = true;
+    for (size_t i = 0; i < b.size(); ++i) {
+        const HalfPlane h = left_of(b[i], b[(i + 1) % b.size()]);
+        double lo = HUGE_VAL;
+        for (Vec2 x : a) lo = std::min(lo, h.value(x));
+        double hi = -HUGE_VAL;
+        for (Vec2 x : a) hi = std::max(hi, h.value(x));
+        if (hi <= 0) return Overlap::disjoint;
+        if (lo < 0) a_inside_b = false;
+    }
+    for (size_t i = 0; i < a.size(); ++i) {
+        const HalfPlane h = left_of(a[i], a[(i + 1) % a.size()]);
+        double hi = -HUGE_VAL;
+        for (Vec2 x : b) hi = std::max(hi, h.value(x));
+        if (hi <= 0) return Overlap::disjoint;
+    }
+    return a_inside_b ? Overlap::inside : Overlap::partial;
+}
+
+bool contains(const ConvexPolygon& polygon, Vec2 x) {
+    const size_t n = polygon.size();
+    if (n < 3) return false;
+    for (size_t i = 0; i < n; ++i)
+        if (left_of(polygon[i], polygon[(i + 1) % n]).value(x) < 0) return false;
+    return true;
+}
+
+Vec2 inverse_bilinear(Vec2 q0, Vec2 q1, Vec2 q2, Vec2 q3, Vec2 q) {
+    // P(s,t) = q0 + s e + t f + s t g. Eliminating s from q - q0 - t f = s (e + t g) leaves
+    // k2 t^2 + k1 t + k0 = 0 (as in Quilez's inverse bilinear interpolation).
+    const Vec2 e = q1 - q0, f = q3 - q0, g = q0 - q1 + q2 - q3, h = q - q0;
+    const double k2 = cross(g, f);
+    const double k1 = cross(h, g) + cross(e, f);
+    const double k0 = cross(h, e);
+    // Stable roots q_r / k2 and k0 / q_r; for a parallelogram k2 = 0 and only k0 / q_r is finite.
+    const double disc = std::max(0.0, k1 * k1 - 4 * k0 * k2);  // < 0 only outside
+    const double q_r = -0.5 * (k1 + std::copysign(std::sqrt(disc), k1));
+    double t = 0;
+    if (q_r != 0) {
+        const double r1 = k0 / q_r;
+        const double r2 = k2 != 0 ? q_r / k2 : HUGE_VAL;
+        // The root in [0, 1], or the one nearer to that interval when extrapolating.
+        auto off = [](double r) { return r < 0 ? -r : (r > 1 ? r - 1 : 0.0); };
+        t = off(r1) <= off(r2) ? r1 : r2;
+    }
+    const Vec2 d = e + t * g;
+    double s = dot(h - t * f, d) / dot(d, d);
+    // Two Newton steps on P(s,t) = q polish the rounding of the closed form.
+    for (int it = 0; it < 2; ++it) {
+        const Vec2 r = q0 + s * e + t * f + (s * t) * g - q;
+        const Vec2 ps = e + t * g, pt = f + s * g;
+        const double det = cross(ps, pt);
+        if (det == 0) break;
+        s -= cross(r, pt) / det;
+        t -= cross(ps, r) / det;
+    }
+    return {s, t};
+}
+
+TriangleRule triangle_rule(int n) {
+    // Duffy's map (xi, eta) -> (xi (1 - eta), xi eta) of [0,1]^2 onto the triangle, Jacobian xi.
+    const GaussLegendre g = gauss_legendre(n);
+    TriangleRule rule;
+    for (int a = 0; a < n; ++a)
+        for (int b = 0; b < n; ++b) {
+            const double xi = 0.5 * (g.x[a] + 1), eta = 0.5 * (g.x[b] + 1);
+            rule.points.push_back({xi * (1 - eta), xi * eta});
+            rule.weights.push_back(0.25 * g.w[a] * g.w[b] * xi);
+        }
+    return rule;
+}
+
+}  // namespace mbr

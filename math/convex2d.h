@@ -1,0 +1,67 @@
+// math/convex2d.h - convex polygons of the plane: clipping by half-planes, intersection and
+// difference, and a Gauss rule on triangles. The exact visibility of mbr's shadow stage (a
+// shooter's visible part seen from a receiving point, radiosity/shadow.h) is built from these:
+// the shooter's cells cut by the receiving point's horizon and by the central projections of
+// occluders onto the shooter's plane (Sutherland and Hodgman 1974 for the clipping).
+#pragma once
+
+#include <vector>
+
+#include "math/gauss_legendre.h"
+#include "math/vec3.h"
+
+namespace mbr {
+
+/// A convex polygon of the plane, vertices counter-clockwise (positive area); may be empty.
+using ConvexPolygon = std::vector<Vec2>;
+
+/// The half-plane {x : dot(normal, x) + offset >= 0}.
+struct HalfPlane {
+    Vec2 normal;
+    double offset = 0;
+    double value(Vec2 x) const { return dot(normal, x) + offset; }
+};
+
+/// Signed area (positive for counter-clockwise vertices).
+double signed_area(const ConvexPolygon& polygon);
+
+/// The half-plane to the left of the directed line a -> b (the inside of a counter-clockwise
+/// polygon with edge a b).
+HalfPlane left_of(Vec2 a, Vec2 b);
+
+/// The part of `polygon` in the half-plane (Sutherland-Hodgman against one line); fewer than
+/// three vertices left means empty.
+ConvexPolygon clip(const ConvexPolygon& polygon, const HalfPlane& h);
+
+/// The intersection of two convex polygons (empty when they are disjoint or touch only).
+ConvexPolygon intersect(const ConvexPolygon& a, const ConvexPolygon& b);
+
+/// a minus b as disjoint convex pieces: the parts of a outside each edge line of b in turn.
+/// Pieces of area below `min_area` are dropped.
+std::vector<ConvexPolygon> subtract(const ConvexPolygon& a, const ConvexPolygon& b,
+                                    double min_area = 0);
+
+/// How a convex polygon lies relative to another: disjoint (at most touching), inside it
+/// (within `slack` of its edges), or overlapping.
+enum class Overlap { disjoint, inside, partial };
+/// Where `a` lies relative to `b` (separating-axis test over both polygons' edges).
+Overlap classify(const ConvexPolygon& a, const ConvexPolygon& b);
+
+/// True when x lies in the closed convex polygon.
+bool contains(const ConvexPolygon& polygon, Vec2 x);
+
+/// The inverse of the bilinear map P(s,t) = (1-s)(1-t) q0 + s(1-t) q1 + s t q2 + (1-s) t q3 of
+/// a convex quadrilateral: the (s,t) with P(s,t) = q, exact up to rounding (closed form, then
+/// two Newton steps). For q outside the quadrilateral it extrapolates (the root nearest [0,1]).
+Vec2 inverse_bilinear(Vec2 q0, Vec2 q1, Vec2 q2, Vec2 q3, Vec2 q);
+
+/// An n x n collapsed Gauss-Legendre rule on the reference triangle (0,0), (1,0), (0,1)
+/// (Duffy's map of the square): points and weights summing to 1/2, exact for polynomials of
+/// total degree 2n - 2.
+struct TriangleRule {
+    std::vector<Vec2> points;
+    std::vector<double> weights;
+};
+TriangleRule triangle_rule(int n);
+
+}  // namespace mbr
