@@ -191,6 +191,7 @@ struct Octree::Query {
     Ray ray;                     // closest hit: t_max shrinks to the best hit found so far
     Vec3 inv_dir;                // 1 / dir per component (unused where dir is zero)
     bool any = false;            // any-hit query: stop at the first hit
+    RayFilter filter;            // surfaces whose polygons are skipped
     int best = -1;               // polygon of the best hit so far
     std::array<int, 32> recent;  // polygon tested recently, by polygon index mod 32
     RayStats stats;
@@ -283,6 +284,7 @@ bool Octree::traverse(const Node& node, const Box3& cube, Query& q) const {
             int& slot = q.recent[id & 31];
             if (slot == id) continue;
             slot = id;
+            if (q.filter.skips(polygons_[id].surface())) continue;
             ++q.stats.n_polygons_tested;
             std::optional<double> t = polygons_[id].intersect(q.ray);
             if (!t) continue;
@@ -342,10 +344,15 @@ std::optional<Hit> Octree::closest_hit(const Ray& ray, RayStats* stats) const {
 }
 
 bool Octree::any_hit(const Ray& ray, RayStats* stats) const {
+    return any_hit(ray, RayFilter{}, stats);
+}
+
+bool Octree::any_hit(const Ray& ray, const RayFilter& filter, RayStats* stats) const {
     if (!root_) return false;
     Query q;
     q.ray = ray;
     q.any = true;
+    q.filter = filter;
     q.recent.fill(-1);
     for (int k = 0; k < 3; ++k) q.inv_dir[k] = ray.dir[k] != 0 ? 1 / ray.dir[k] : 0;
     double t0 = ray.t_min, t1 = ray.t_max;
@@ -354,5 +361,10 @@ bool Octree::any_hit(const Ray& ray, RayStats* stats) const {
     if (stats) *stats += q.stats;
     return hit;
 }
+
+bool Octree::node_is_leaf(const Node& node) { return node.is_leaf; }
+const std::vector<int>& Octree::node_polygons(const Node& node) { return node.polygons; }
+const Octree::Node* Octree::node_child(const Node& node, int i) { return node.children[i].get(); }
+Box3 Octree::node_child_cube(const Box3& cube, int i) { return child_cube(cube, i); }
 
 }  // namespace mbr

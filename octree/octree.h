@@ -16,6 +16,7 @@
 // Only the tolerances that steer rounding towards "meet" (1e-12 of the coordinates) remain.
 #pragma once
 
+#include <algorithm>
 #include <memory>
 #include <optional>
 #include <ostream>
@@ -76,6 +77,14 @@ struct RayStats {
     RayStats& operator+=(const RayStats& other);
 };
 
+/// Polygons a ray query skips: those of up to two surfaces (a shadow ray between a shooter and a
+/// receiver is never blocked by the two surfaces themselves).
+struct RayFilter {
+    int skip_surface_a = -1;
+    int skip_surface_b = -1;
+    bool skips(int surface) const { return surface == skip_surface_a || surface == skip_surface_b; }
+};
+
 /// Build options of the octree.
 struct OctreeOptions {
     int max_depth = 10;             // depth of the deepest allowed node (the root has depth 0)
@@ -107,6 +116,19 @@ public:
     /// Whether any polygon is hit with t in [ray.t_min, ray.t_max] (shadow rays). Stops at the
     /// first hit found. Adds its work to *stats if given.
     bool any_hit(const Ray& ray, RayStats* stats = nullptr) const;
+    /// The same, skipping the polygons of the surfaces `filter` names.
+    bool any_hit(const Ray& ray, const RayFilter& filter, RayStats* stats = nullptr) const;
+    /// The polygons listed by the leaves whose grown cubes `node_may_meet` accepts (it is asked
+    /// for every node on the way down, so a region query prunes whole subtrees), each once, in
+    /// increasing order.
+    template <class NodeTest>
+    std::vector<int> polygons_near(NodeTest&& node_may_meet) const {
+        std::vector<int> out;
+        if (root_) collect(*root_, root_cube_, node_may_meet, out);
+        std::sort(out.begin(), out.end());
+        out.erase(std::unique(out.begin(), out.end()), out.end());
+        return out;
+    }
 
     /// The polygons, in the order given to the constructor (Hit::polygon indexes them).
     const std::vector<Polygon>& polygons() const { return polygons_; }
@@ -132,6 +154,12 @@ private:
     std::unique_ptr<Node> build(const Box3& cube, std::vector<int> ids, int depth);
     Box3 grown(const Box3& cube) const;
     bool traverse(const Node& node, const Box3& cube, Query& query) const;
+    template <class NodeTest>
+    void collect(const Node& node, const Box3& cube, NodeTest& test, std::vector<int>& out) const;
+    static bool node_is_leaf(const Node& node);
+    static const std::vector<int>& node_polygons(const Node& node);
+    static const Node* node_child(const Node& node, int i);
+    static Box3 node_child_cube(const Box3& cube, int i);
 
     std::vector<Polygon> polygons_;
     Options options_;
@@ -143,5 +171,18 @@ private:
     int depth_ = 0;
     long reference_count_ = 0;
 };
+
+template <class NodeTest>
+void Octree::collect(const Node& node, const Box3& cube, NodeTest& test,
+                     std::vector<int>& out) const {
+    if (!test(grown(cube))) return;
+    if (node_is_leaf(node)) {
+        const std::vector<int>& ids = node_polygons(node);
+        out.insert(out.end(), ids.begin(), ids.end());
+        return;
+    }
+    for (int i = 0; i < 8; ++i)
+        if (const Node* child = node_child(node, i)) collect(*child, node_child_cube(cube, i), test, out);
+}
 
 }  // namespace mbr
