@@ -1,6 +1,7 @@
 // radiosity/kernel.cpp - the analytic reference form factor and the adaptive quadrature of (21).
 #include "radiosity/kernel.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "math/check.h"
@@ -47,7 +48,15 @@ double point_polygon_form_factor(Vec3 p, Vec3 n_p, const std::vector<Vec3>& poly
     return std::fabs(sum) / (2 * Pi);
 }
 
-IncrementIntegrator::IncrementIntegrator(const Shooter& shooter, const QuadratureOptions& options)
+namespace {
+/// A dyadic cell of the shooter as one integer: level (5 bits), i and j (28 bits each).
+std::uint64_t cell_key(const QuadCell& cell) {
+    return (std::uint64_t(cell.level) << 56) | (std::uint64_t(cell.i) << 28) | std::uint64_t(cell.j);
+}
+}  // namespace
+
+IncrementIntegrator::IncrementIntegrator(const Shooter& shooter, const QuadratureOptions& options,
+                                         const OcclusionContext* occlusion)
     : shooter_(shooter), options_(options) {
     MBR_CHECK(shooter.surface != nullptr && !shooter.unshot.empty());
     MBR_CHECK(options.n >= 1 && options.max_depth >= 0 && options.max_depth <= 28);
@@ -58,6 +67,13 @@ IncrementIntegrator::IncrementIntegrator(const Shooter& shooter, const Quadratur
     unshot_values_.resize(size_t(options.n + 1) * (options.n + 1));
     rules_.resize(options.n + 2);
     for (int n = 1; n <= options.n + 1; ++n) rules_[n] = gauss_legendre(n);
+    planar_ = shooter.surface->kind() == Surface::Kind::PlanarQuad;
+    if (planar_) {
+        plane_ = make_shooter_plane(*shooter.surface);
+        tri_rules_.resize(options.n + 2);
+        for (int n = 1; n <= options.n + 1; ++n) tri_rules_[n] = triangle_rule(n);
+    }
+    if (occlusion && !occlusion->clear()) occlusion_ = occlusion;
 }
 
 IncrementIntegrator::PointSpan IncrementIntegrator::points(const QuadCell& cell, int n) {
@@ -106,22 +122,112 @@ Rgb IncrementIntegrator::sum_over(const SurfacePoint& p, PointSpan pts) const {
     return sum;
 }
 
+void IncrementIntegrator::set_view(const SurfacePoint& p) {
+    extra_evaluations_ = 0;
+    rays_ = 0;
+    mixed_.clear();
+    pieces_key_ = ~0ULL;
+    if (planar_ && (options_.clip_horizon || occlusion_))
+        view_ = blocked_view(plane_, p.position, p.normal, occlusion_);
+    else
+        view_ = BlockedView{};
+    if (!options_.clip_horizon) {  // shadows only: the horizon is left to the clamped cosine
+        view_.horizon_cuts = false;
+        view_.behind_all = false;
+    }
+}
+
+ConvexPolygon IncrementIntegrator::cell_image(const QuadCell& cell) const {
+    // Iso-parameter lines of a bilinear map are straight: a cell's image is the quadrilateral of
+    // its corners (counter-clockwise, as the whole quad's).
+    const Rect& r = cell.rect;
+    return {plane_.at(r.x0, r.y0), plane_.at(r.x1, r.y0), plane_.at(r.x1, r.y1), plane_.at(r.x0, r.y1)};
+}
+
+Rgb IncrementIntegrator::pieces_value(const SurfacePoint& p, const std::vector<ConvexPolygon>& pieces,
+                                      int n) {
+    // The n x n collapsed Gauss rule on a fan of triangles of each convex piece, in the shooter's
+    // plane: int F(p, x) B_h(u(x), v(x)) dA(x) (dA is the plane's own area element, so the area
+    // factor A_h of the parameter map does not appear).
+    const TriangleRule& rule = tri_rules_[n];
+    const Rgb constant_b = unshot_constant_ ? shooter_.unshot.coefficient(0, 0) : Rgb{};
+    Rgb sum;
+    for (const ConvexPolygon& piece : pieces)
+        for (size_t k = 1; k + 1 < piece.size(); ++k) {
+            const Vec2 a = piece[0], b = piece[k], c = piece[k + 1];
+            const double jacobian = std::fabs(cross(b - a, c - a));  // twice the area
+            if (jacobian <= 0) continue;
+            for (size_t q = 0; q < rule.points.size(); ++q) {
+                const Vec2 X = a + rule.points[q].x * (b - a) + rule.points[q].y * (c - a);
+                const double F = form_factor_kernel(p.position, p.normal, plane_.to_space(X), plane_.normal);
+                ++extra_evaluations_;
+                if (F == 0) continue;
+                Rgb B = constant_b;
+                if (!unshot_constant_) {
+                    const Vec2 uv = plane_.parameters(X);
+                    B = shooter_.unshot.evaluate(std::clamp(uv.x, 0.0, 1.0), std::clamp(uv.y, 0.0, 1.0));
+                }
+                sum += (rule.weights[q] * jacobian * F) * B;
+            }
+        }
+    return sum;
+}
+
+Rgb IncrementIntegrator::cell_value(const SurfacePoint& p, const QuadCell& cell, int n) {
+    if (planar_ && !view_.trivial()) {
+        const ConvexPolygon image = cell_image(cell);
+        switch (classify_cell(image, view_)) {
+            case CellVisibility::hidden: return Rgb{};
+            case CellVisibility::clear: return sum_over(p, points(cell, n));
+            case CellVisibility::cut: {
+                const std::uint64_t key = cell_key(cell);
+                if (key != pieces_key_) {  // the n and n+1 rules of one cell share the pieces
+                    pieces_ = visible_pieces(image, view_);
+                    pieces_key_ = key;
+                }
+                return pieces_value(p, pieces_, n);
+            }
+        }
+    }
+    if (!occlusion_ || planar_) return sum_over(p, points(cell, n));
+    // A curved shooter with occluders: one visibility ray per node (eq. (21) with VIS).
+    const PointSpan pts = points(cell, n);
+    Rgb sum;
+    int n_visible = 0, n_blocked = 0;
+    for (int i = 0; i < pts.count; ++i) {
+        const ShooterPoint& q = pts.first[i];
+        const double F = form_factor_kernel(p.position, p.normal, q.x, q.n);
+        if (F == 0) continue;
+        if (segment_blocked(*occlusion_, p.position, q.x, &rays_)) {
+            ++n_blocked;
+            continue;
+        }
+        ++n_visible;
+        sum += F * q.e;
+    }
+    if (n_visible > 0 && n_blocked > 0) mixed_.push_back(cell_key(cell));
+    return sum;
+}
+
 IncrementIntegrator::Result IncrementIntegrator::integrate(const SurfacePoint& p,
-                                                           bool keep_partition) {
+                                                           bool keep_partition, int min_depth) {
+    Result result;
+    set_view(p);
+    if (view_.behind_all) return result;  // the whole shooter is behind p: nothing arrives
     // The tolerance is relative to the (n+1)-point estimate over the whole shooter, with a
     // floor at 1e-4 of the largest possible value (F integrates to at most 1 over the shooter,
     // so I(p) <= max B_h): a point that sees almost nothing does not ask for endless splitting.
+    // (The estimate ignores occluders: a shadowed point keeps the tolerance of a lit one.)
     const QuadCell root{0, 0, 0, Rect{0, 1, 0, 1}};
     const double estimate = max_abs(sum_over(p, points(root, options_.n + 1)));
     const double scale = std::max(estimate, 1e-4 * unshot_bound_);
-    Result result;
     AdaptiveOptions opt;
     opt.n = options_.n;
     opt.tolerance = options_.rel_tolerance * scale;
     opt.max_depth = options_.max_depth;
-    opt.min_depth = options_.min_depth;
+    opt.min_depth = min_depth >= 0 ? std::min(min_depth, options_.max_depth) : options_.min_depth;
     opt.min_share = options_.min_share;
-    auto cell_rule = [&](const QuadCell& cell, int n) { return sum_over(p, points(cell, n)); };
+    auto cell_rule = [&](const QuadCell& cell, int n) { return cell_value(p, cell, n); };
     // DESIGN: on a single cell the n- and (n+1)-point rules can agree by chance on a peaked
     // integrand, so the whole shooter is never accepted as one cell (min_depth = 1: with n = 6
     // a point of the perpendicular squares at (0.69, 0.24) was accepted at the root 1.3e-3 off,
@@ -130,6 +236,9 @@ IncrementIntegrator::Result IncrementIntegrator::integrate(const SurfacePoint& p
     // the shooter sees. A cell is trusted only when it is well separated from p: its points'
     // extent at most near_field times their distance from p.
     auto near = [&](const QuadCell& cell) {
+        if (occlusion_ && !planar_ && cell.level < options_.max_visibility_depth &&
+            std::find(mixed_.begin(), mixed_.end(), cell_key(cell)) != mixed_.end())
+            return true;  // its nodes disagree on visibility: split
         if (options_.near_field <= 0) return false;
         const PointSpan pts = points(cell, options_.n + 1);
         Box3 box;
@@ -139,7 +248,8 @@ IncrementIntegrator::Result IncrementIntegrator::integrate(const SurfacePoint& p
     };
     auto r = adaptive_tensor_rule_2d(cell_rule, root.rect, opt, keep_partition, near);
     result.value = r.value;
-    result.n_evaluations = r.n_evaluations + long(options_.n + 1) * (options_.n + 1);
+    result.n_evaluations = r.n_evaluations + long(options_.n + 1) * (options_.n + 1) + extra_evaluations_;
+    result.n_rays = rays_;
     result.converged = r.converged;
     result.partition = std::move(r.cells);
     return result;
@@ -147,10 +257,14 @@ IncrementIntegrator::Result IncrementIntegrator::integrate(const SurfacePoint& p
 
 Rgb IncrementIntegrator::integrate_on(const SurfacePoint& p,
                                       const std::vector<AcceptedCell<Rgb>>& partition,
-                                      long* n_evaluations) {
+                                      long* n_evaluations, long* n_rays) {
+    set_view(p);
     Rgb sum;
-    for (const auto& c : partition) sum += sum_over(p, points(c.cell, options_.n + 1));
-    if (n_evaluations) *n_evaluations += long(partition.size()) * (options_.n + 1) * (options_.n + 1);
+    if (!view_.behind_all)
+        for (const auto& c : partition) sum += cell_value(p, c.cell, options_.n + 1);
+    if (n_evaluations)
+        *n_evaluations += long(partition.size()) * (options_.n + 1) * (options_.n + 1) + extra_evaluations_;
+    if (n_rays) *n_rays += rays_;
     return sum;
 }
 

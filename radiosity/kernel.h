@@ -8,7 +8,9 @@
 #include <unordered_map>
 #include <vector>
 
+#include "math/convex2d.h"
 #include "math/gauss_legendre.h"
+#include "radiosity/shadow.h"
 #include "radiosity/spline_field.h"
 #include "radiosity/surface.h"
 
@@ -48,6 +50,12 @@ struct QuadratureOptions {
     double min_share = 1e-6;      // floor of a cell's share of the tolerance (math/gauss_legendre.h)
     double near_field = 4.0;      // split a cell whose extent exceeds near_field times its
                                   //   distance from the receiving point (0: never)
+    bool clip_horizon = true;     // planar shooters: integrate cells the receiving point's
+                                  //   tangent plane cuts over their front part only (exact
+                                  //   convex pieces), instead of chasing the kink of the
+                                  //   clamped cosine of (3) down to max_depth
+    int max_visibility_depth = 10;  // exact visibility on a curved shooter: cells whose nodes
+                                  //   disagree on visibility are split down to this level
 };
 
 /// One shooter point of the quadrature with everything that does not depend on the receiver:
@@ -60,28 +68,34 @@ struct ShooterPoint {
 };
 
 /// The integral of eq. (21) without the receiver's reflectance:
-///   I(p) = int_{[0,1]^2} F(p, x_h(u,v)) VIS B_h(u,v) A_h(u,v) du dv   (VIS = 1 here),
+///   I(p) = int_{[0,1]^2} F(p, x_h(u,v)) VIS B_h(u,v) A_h(u,v) du dv,
 /// by the adaptive rule of section 6 (n against n + 1 points per cell, split in four with a
-/// quarter of the tolerance). Shooter points are cached per dyadic cell, so one integrator per
-/// thread: the cache changes speed, never values, so results do not depend on thread count.
+/// quarter of the tolerance). VIS = 1 unless an occlusion context is given (exact visibility,
+/// radiosity/shadow.h): then a planar shooter's cells are clipped to what p sees, and a curved
+/// shooter's nodes each cast a ray. Shooter points are cached per dyadic cell, so one
+/// integrator per thread: the cache changes speed, never values, so results do not depend on
+/// thread count.
 class IncrementIntegrator {
 public:
-    IncrementIntegrator(const Shooter& shooter, const QuadratureOptions& options);
+    IncrementIntegrator(const Shooter& shooter, const QuadratureOptions& options,
+                        const OcclusionContext* occlusion = nullptr);
 
     struct Result {
         Rgb value;
         long n_evaluations = 0;   // kernel evaluations
+        long n_rays = 0;          // visibility rays (exact visibility on a curved shooter)
         bool converged = true;
         std::vector<AcceptedCell<Rgb>> partition;  // the shooter's cells, when asked for
     };
     /// I(p) by the adaptive rule; the shooter partition is kept when keep_partition is set
     /// (the shadow stage casts rays to its cells; edgefill reuses it for divided differences).
-    Result integrate(const SurfacePoint& p, bool keep_partition = false);
+    /// min_depth >= 0 overrides the options' smallest depth of the partition.
+    Result integrate(const SurfacePoint& p, bool keep_partition = false, int min_depth = -1);
     /// I(p) on a given partition with the (n+1)-point rule on each cell: the same quadrature
     /// error pattern as the run that made the partition, so divided differences (22) of nearby
     /// points are not swamped by it.
     Rgb integrate_on(const SurfacePoint& p, const std::vector<AcceptedCell<Rgb>>& partition,
-                     long* n_evaluations);
+                     long* n_evaluations, long* n_rays = nullptr);
     /// The points of a cell for the n-point rule (cached): n*n points from `first`, valid until
     /// the next call.
     struct PointSpan {
@@ -92,8 +106,26 @@ public:
 
 private:
     Rgb sum_over(const SurfacePoint& p, PointSpan pts) const;
+    /// The n x n rule on one cell as p sees it (the view of the last set_view): cached points
+    /// for a clear cell, zero for a hidden one, convex pieces for a cut one; per-node rays on
+    /// a curved shooter with an occlusion context.
+    Rgb cell_value(const SurfacePoint& p, const QuadCell& cell, int n);
+    void set_view(const SurfacePoint& p);
+    ConvexPolygon cell_image(const QuadCell& cell) const;
+    Rgb pieces_value(const SurfacePoint& p, const std::vector<ConvexPolygon>& pieces, int n);
+
     const Shooter& shooter_;
     QuadratureOptions options_;
+    const OcclusionContext* occlusion_ = nullptr;  // exact visibility when set (and not clear)
+    bool planar_ = false;               // the shooter is a planar quad: exact clipping works
+    ShooterPlane plane_;                // its frame
+    BlockedView view_;                  // what the current point cannot see
+    std::vector<TriangleRule> tri_rules_;  // tri_rules_[n]
+    long extra_evaluations_ = 0;        // kernel evaluations on cut pieces (current point)
+    long rays_ = 0;                     // rays cast for the current point
+    std::vector<std::uint64_t> mixed_;  // cells whose nodes disagreed on visibility (curved)
+    std::uint64_t pieces_key_ = ~0ULL;  // the cut cell whose pieces are in pieces_
+    std::vector<ConvexPolygon> pieces_;
     std::vector<GaussLegendre> rules_;  // rules_[n]
     std::vector<ShooterPoint> pool_;    // every cached cell's points, one after the other
     std::vector<Rgb> unshot_values_;    // scratch: B_h on one cell's grid

@@ -42,6 +42,8 @@ public:
         int first_child = -1;  // index of child (0,0); children (1,0), (0,1), (1,1) follow
         int parent = -1;
         int samples = -1;      // index of the leaf's m x m samples, -1 when not computed
+        bool resampled = false;  // its samples were resampled from its parent's polynomial (a
+                                 //   leaf made by shadow subdivision), not computed by (21)
         bool is_leaf() const { return first_child < 0; }
     };
 

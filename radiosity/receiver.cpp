@@ -9,31 +9,13 @@
 #include "math/bspline.h"
 #include "math/check.h"
 #include "math/gauss_legendre.h"
+#include "math/parallel.h"
 #include "math/polynomial.h"
 
-#ifdef _OPENMP
-#include <omp.h>
-#endif
 
 namespace mbr {
 
 namespace {
-
-int max_threads() {
-#ifdef _OPENMP
-    return omp_get_max_threads();
-#else
-    return 1;
-#endif
-}
-
-int thread_id() {
-#ifdef _OPENMP
-    return omp_get_thread_num();
-#else
-    return 0;
-#endif
-}
 
 double seconds_since(std::chrono::steady_clock::time_point start) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -96,11 +78,19 @@ void EdgeProfile::at(double s, Rgb& v, Rgb& d) const {
 // ---- Sample values, eq. (21) -------------------------------------------------------------
 
 IncrementSampler::IncrementSampler(const Shooter& shooter, const ReceiverSurface& receiver,
-                                   const QuadratureOptions& options)
-    : receiver_(receiver) {
+                                   const QuadratureOptions& options,
+                                   const OcclusionContext* occlusion)
+    : shooter_(shooter), receiver_(receiver) {
     MBR_CHECK(receiver.surface != nullptr && receiver.reflectance);
-    for (int i = 0; i < max_threads(); ++i)
-        integrators_.push_back(std::make_unique<IncrementIntegrator>(shooter, options));
+    for (int i = 0; i < thread_count(); ++i)
+        integrators_.push_back(std::make_unique<IncrementIntegrator>(shooter, options, occlusion));
+    rays_.assign(integrators_.size(), 0);
+}
+
+long IncrementSampler::n_rays() const {
+    long n = 0;
+    for (long r : rays_) n += r;
+    return n;
 }
 
 Rgb IncrementSampler::sample(double s, double t, int thread, long* n_kernel_evals,
@@ -109,6 +99,7 @@ Rgb IncrementSampler::sample(double s, double t, int thread, long* n_kernel_eval
     const SurfacePoint p = receiver_.surface->evaluate(s, t);
     const IncrementIntegrator::Result r = integrators_[thread]->integrate(p);
     if (n_kernel_evals) *n_kernel_evals += r.n_evaluations;
+    rays_[thread] += r.n_rays;
     if (converged) *converged = r.converged;
     return receiver_.reflectance(s, t) * r.value;
 }
@@ -120,7 +111,8 @@ void IncrementSampler::sample_pair(double s, double t, double ds, double dt, int
     const IncrementIntegrator::Result r = integrator.integrate(p, true);
     const SurfacePoint q = receiver_.surface->evaluate(s + ds, t + dt);
     long evals = r.n_evaluations;
-    const Rgb value_q = integrator.integrate_on(q, r.partition, &evals);
+    rays_[thread] += r.n_rays;
+    const Rgb value_q = integrator.integrate_on(q, r.partition, &evals, &rays_[thread]);
     if (n_kernel_evals) *n_kernel_evals += evals;
     at_p = receiver_.reflectance(s, t) * r.value;
     at_q = receiver_.reflectance(s + ds, t + dt) * value_q;
@@ -152,6 +144,42 @@ void subdivide_by_oracle(ReceiverState& state, IncrementSampler& sampler) {
         return sum;
     };
 
+    // Beyond the paper (OracleTest::Interpolation): the tensor polynomial through the m x m
+    // samples must predict the samples at the ceil(m/2)^2 points within the tolerance, point by
+    // point: a direct test of "can be approximated by a double (m-1)th order tensor product
+    // polynomial", which a kink of a shadow boundary fails even where the two means agree.
+    std::vector<double> c_nodes(rule_c.x.begin(), rule_c.x.end());
+    const std::vector<double> L = lagrange_matrix(rule_m, c_nodes);  // [p * m + a]
+    auto interpolation_agrees = [&](const Rect& r, int thread, long* evals, long* increments,
+                                    double scale) {
+        const int nc = rule_c.n();
+        double s_m[16], t_m[16], s_c[16], t_c[16];
+        gauss_points(r, rule_m, s_m, t_m);
+        gauss_points(r, rule_c, s_c, t_c);
+        Rgb f_m[256], f_c[64];
+        double largest = 0;
+        for (int a = 0; a < m; ++a)
+            for (int b = 0; b < m; ++b) {
+                f_m[a * m + b] = sampler.sample(s_m[a], t_m[b], thread, evals);
+                largest = std::max(largest, max_abs(f_m[a * m + b]));
+            }
+        for (int a = 0; a < nc; ++a)
+            for (int b = 0; b < nc; ++b) {
+                f_c[a * nc + b] = sampler.sample(s_c[a], t_c[b], thread, evals);
+                largest = std::max(largest, max_abs(f_c[a * nc + b]));
+            }
+        *increments += m * m + nc * nc;
+        const double tol = opt.oracle_tolerance * std::max(largest, 0.01 * scale);
+        for (int a = 0; a < nc; ++a)
+            for (int b = 0; b < nc; ++b) {
+                Rgb p;
+                for (int i = 0; i < m; ++i)
+                    for (int j = 0; j < m; ++j) p += (L[a * m + i] * L[b * m + j]) * f_m[i * m + j];
+                if (max_abs(p - f_c[a * nc + b]) > tol) return false;
+            }
+        return true;
+    };
+
     // Scale for the oracle's floor: the largest of the m x m samples of the whole domain
     // (not needed when the bounds leave the oracle nothing to decide).
     double scale = 0;
@@ -169,23 +197,28 @@ void subdivide_by_oracle(ReceiverState& state, IncrementSampler& sampler) {
         const int n = static_cast<int>(frontier.size());
         std::vector<Action> action(n, Leaf);
         std::vector<long> evals(n, 0), increments(n, 0);
-#pragma omp parallel for schedule(dynamic, 1)
-        for (int c = 0; c < n; ++c) {
+        parallel_for(n, [&](int c) {
             const DyadicCell cell = forest.node(frontier[c]).cell;
             if (cell.level < opt.min_depth) {
                 action[c] = Split;
-                continue;
+                return;
             }
-            if (cell.level >= opt.max_depth) continue;  // a leaf
+            if (cell.level >= opt.max_depth) return;  // a leaf
+            const int th = thread_index();
+            if (opt.oracle_test == OracleTest::Interpolation) {
+                action[c] = interpolation_agrees(cell.rect(), th, &evals[c], &increments[c], scale)
+                                ? SplitOnceMore
+                                : Split;
+                return;
+            }
             // Section 6 "Oracle": ceil(m/2)^2 against m^2 Gauss-Legendre points.
-            const int th = thread_id();
             const Rgb coarse = cell_mean(cell.rect(), rule_c, th, &evals[c], &increments[c]);
             const Rgb fine = cell_mean(cell.rect(), rule_m, th, &evals[c], &increments[c]);
             // DESIGN: relative agreement, with a floor at 1% of the largest value in the domain
             // so that nearly dark cells do not split forever.
             const double tol = opt.oracle_tolerance * std::max(max_abs(fine), 0.01 * scale);
             action[c] = max_abs(fine - coarse) <= tol ? SplitOnceMore : Split;
-        }
+        });
         std::vector<int> next;
         for (int c = 0; c < n; ++c) {
             stats.n_kernel_evals += evals[c];
@@ -258,8 +291,7 @@ void sample_leaves(ReceiverState& state, IncrementSampler& sampler) {
     const int n = static_cast<int>(todo.size());
     std::vector<long> evals(n, 0);
     std::vector<int> unconverged(n, 0);
-#pragma omp parallel for schedule(dynamic, 1)
-    for (int c = 0; c < n; ++c) {
+    parallel_for(n, [&](int c) {
         const Forest::Node& node = state.forest.node(todo[c]);
         double s[16], t[16];
         gauss_points(node.cell.rect(), rule, s, t);
@@ -267,10 +299,10 @@ void sample_leaves(ReceiverState& state, IncrementSampler& sampler) {
         for (int a = 0; a < m; ++a)
             for (int b = 0; b < m; ++b) {
                 bool converged = true;
-                out[a * m + b] = sampler.sample(s[a], t[b], thread_id(), &evals[c], &converged);
+                out[a * m + b] = sampler.sample(s[a], t[b], thread_index(), &evals[c], &converged);
                 if (!converged) ++unconverged[c];
             }
-    }
+    });
     for (int c = 0; c < n; ++c) {
         state.stats.n_kernel_evals += evals[c];
         state.stats.n_increments += long(m) * m;
@@ -351,10 +383,10 @@ void fill_boundary(ReceiverState& state, IncrementSampler& sampler) {
             const int n = static_cast<int>(open.size());
             std::vector<Node> mid(n);
             std::vector<long> mid_evals(n, 0);
-#pragma omp parallel for schedule(dynamic, 1)
-            for (int i = 0; i < n; ++i)
-                mid[i] = evaluate(e, 0.5 * (open[i].first.sigma + open[i].second.sigma), thread_id(),
+            parallel_for(n, [&](int i) {
+                mid[i] = evaluate(e, 0.5 * (open[i].first.sigma + open[i].second.sigma), thread_index(),
                                   &mid_evals[i]);
+            });
             std::vector<std::pair<Node, Node>> next;
             for (int i = 0; i < n; ++i) {
                 evals += mid_evals[i];
@@ -556,16 +588,49 @@ void expand_domain(ReceiverState& state, IncrementSampler& sampler) {
     state.samples.resize(state.samples.size() + expanded.size() * m * m);
     const int n = static_cast<int>(expanded.size());
     for (int c = 0; c < n; ++c) forest.node(expanded[c]).samples = int(first_block + c);
-#pragma omp parallel for schedule(static)
-    for (int c = 0; c < n; ++c) {
+    parallel_for(n, [&](int c) {
         const Forest::Node& node = forest.node(expanded[c]);
         double s[16], t[16];
         gauss_points(node.cell.rect(), rule_m, s, t);
         Rgb* out = &state.samples[size_t(node.samples) * m * m];
         for (int a = 0; a < m; ++a)
             for (int b = 0; b < m; ++b) out[a * m + b] = extrapolate(state, s[a], t[b]);
-    }
+    });
     state.stats.n_expanded_leaves = n;
+}
+
+void sample_split_leaves(ReceiverState& state) {
+    const int m = state.options.m;
+    const GaussLegendre rule = gauss_legendre(m);
+    Forest& forest = state.forest;
+    // Children come after their parents in the node array, so a parent's samples exist (from
+    // (21), extrapolation or an earlier resampling) when its children are filled; nodes split
+    // before stage 2 sampled anything have no samples and neither do their children.
+    const std::vector<double> R[2] = {subcell_resample_matrix(rule, 1, 0), subcell_resample_matrix(rule, 1, 1)};
+    for (int index = 0; index < forest.n_nodes(); ++index) {
+        Forest::Node& node = forest.node(index);
+        if (node.samples >= 0 || node.parent < 0 || forest.node(node.parent).samples < 0) continue;
+        node.samples = static_cast<int>(state.samples.size() / (size_t(m) * m));
+        state.samples.resize(state.samples.size() + size_t(m) * m);
+        Rgb* out = &state.samples[size_t(node.samples) * m * m];
+        if (!node.cell.in_domain()) {
+            double s[16], t[16];
+            gauss_points(node.cell.rect(), rule, s, t);
+            for (int a = 0; a < m; ++a)
+                for (int b = 0; b < m; ++b) out[a * m + b] = extrapolate(state, s[a], t[b]);
+            continue;
+        }
+        const Forest::Node& parent = forest.node(node.parent);
+        const int di = node.cell.i & 1, dj = node.cell.j & 1;
+        const Rgb* in = &state.samples[size_t(parent.samples) * m * m];
+        double channel_in[256], channel_out[256];
+        for (int c = 0; c < 3; ++c) {
+            for (int i = 0; i < m * m; ++i) channel_in[i] = in[i][c];
+            resample(m, channel_in, R[di].data(), R[dj].data(), channel_out);
+            for (int i = 0; i < m * m; ++i) out[i][c] = channel_out[i];
+        }
+        node.resampled = true;
+    }
 }
 
 // ---- Stage 5: fulcrums -------------------------------------------------------------------
@@ -755,71 +820,79 @@ void project_in_rhombi(ReceiverState& state, const DualTable& dn) {
     const ProjectionTables& tables = *state.tables;
     const int n = static_cast<int>(state.fulcrums.size());
     std::vector<Rgb> values(n);
-#pragma omp parallel for schedule(dynamic, 4)
-    for (int i = 0; i < n; ++i) values[i] = project(state, dn, tables, state.fulcrums[i]);
+    parallel_for(n, [&](int i) { values[i] = project(state, dn, tables, state.fulcrums[i]); });
     for (int i = 0; i < n; ++i) state.coefficients[state.fulcrums[i]] = values[i];
     state.stats.n_projections += n;
 }
 
 // ---- Stage 8: scale unification, eq. (17) ------------------------------------------------
 
-SplineField unify_scales(ReceiverState& state, const DualTable& dn) {
+Rgb resolve_coefficient(ReceiverState& state, const DualTable& dn, const Fulcrum& f,
+                        std::map<Fulcrum, Rgb>& refined) {
+    auto stored = state.coefficients.find(f);
+    if (stored != state.coefficients.end()) return stored->second;
+    auto memo = refined.find(f);
+    if (memo != refined.end()) return memo->second;
     const int m = state.options.m;
     const Forest& forest = state.forest;
-    int j = 0;
-    for (const Fulcrum& f : state.fulcrums) j = std::max(j, f.level);
-    const int finest_leaf = finest_level(forest);
-    const std::vector<double> p_mk = two_scale_mask(m);
 
-    // The finest leaf level around a fulcrum's position: its own cell for odd m (a centre),
-    // the four cells around the corner for even m.
-    auto local_level = [&](const Fulcrum& f) {
+    // The finest level of (21) samples around a fulcrum's position: its own cell for odd m (a
+    // centre), the four cells around the corner for even m. A leaf of shadow subdivision holds
+    // its parent's samples resampled: it counts at the level those samples were taken.
+    auto sample_level = [&](int leaf) {
+        while (forest.node(leaf).resampled) leaf = forest.node(leaf).parent;
+        return forest.node(leaf).cell.level;
+    };
+    auto local_level = [&]() {
         const Vec2 c = f.position(m);
-        const double eps = std::ldexp(0.25, -finest_leaf);
-        int level = -1;
         if (m % 2 == 1) {
             const int leaf = forest.leaf_at(c.x, c.y);
-            return leaf >= 0 ? forest.node(leaf).cell.level : -1;
+            return leaf >= 0 ? sample_level(leaf) : -1;
         }
+        const double eps = std::ldexp(0.25, -f.level);
+        int level = -1;
         for (int q = 0; q < 4; ++q) {
             const int leaf = forest.leaf_at(c.x + ((q & 1) ? eps : -eps), c.y + ((q & 2) ? eps : -eps));
-            if (leaf >= 0) level = std::max(level, forest.node(leaf).cell.level);
+            if (leaf >= 0) level = std::max(level, sample_level(leaf));
         }
         return level;
     };
 
-    std::map<Fulcrum, Rgb> refined;  // coefficients obtained by (17), memoised
-    // DESIGN: a coefficient is projected (stored, or on demand) where the leaves around its
-    // fulcrum are at least as fine as its scale; elsewhere it is refined from the level
-    // above by (17): a_l = sum_k p_{m,l-2k} a_k in each direction, recursively.
-    std::function<Rgb(const Fulcrum&)> coefficient = [&](const Fulcrum& f) -> Rgb {
-        auto stored = state.coefficients.find(f);
-        if (stored != state.coefficients.end()) return stored->second;
-        auto memo = refined.find(f);
-        if (memo != refined.end()) return memo->second;
-        if (f.level == 0 || state.options.unify_by_projection || local_level(f) >= f.level) {
-            const Rgb c = state.tables ? project(state, dn, *state.tables, f) : project(state, dn, f);
-            state.coefficients[f] = c;
-            ++state.stats.n_projections;
-            return c;
-        }
-        Rgb sum;
-        // Coarse k' with 0 <= k - 2k' <= m, i.e. ceil((k - m) / 2) <= k' <= floor(k / 2).
-        auto floor_half = [](int x) { return x >= 0 ? x / 2 : -((-x + 1) / 2); };
-        const int k0 = -floor_half(m - f.k), k1 = floor_half(f.k);
-        const int l0 = -floor_half(m - f.l), l1 = floor_half(f.l);
-        for (int kc = k0; kc <= k1; ++kc)
-            for (int lc = l0; lc <= l1; ++lc)
-                sum += (p_mk[f.k - 2 * kc] * p_mk[f.l - 2 * lc]) * coefficient({f.level - 1, kc, lc});
-        refined[f] = sum;
-        ++state.stats.n_refined;
-        return sum;
-    };
+    // DESIGN: a coefficient is projected (stored, or on demand) where the samples around its
+    // fulcrum are at least as fine as its scale; elsewhere it is refined from the level above
+    // by (17): a_l = sum_k p_{m,l-2k} a_k in each direction, recursively.
+    if (f.level == 0 || state.options.unify_by_projection || local_level() >= f.level) {
+        Rgb c = state.tables ? project(state, dn, *state.tables, f) : project(state, dn, f);
+        if (state.mask) c = c * state.mask(f);
+        state.coefficients[f] = c;
+        ++state.stats.n_projections;
+        return c;
+    }
+    const std::vector<double> p_mk = two_scale_mask(m);
+    Rgb sum;
+    // Coarse k' with 0 <= k - 2k' <= m, i.e. ceil((k - m) / 2) <= k' <= floor(k / 2).
+    auto floor_half = [](int x) { return x >= 0 ? x / 2 : -((-x + 1) / 2); };
+    const int k0 = -floor_half(m - f.k), k1 = floor_half(f.k);
+    const int l0 = -floor_half(m - f.l), l1 = floor_half(f.l);
+    for (int kc = k0; kc <= k1; ++kc)
+        for (int lc = l0; lc <= l1; ++lc)
+            sum += (p_mk[f.k - 2 * kc] * p_mk[f.l - 2 * lc]) *
+                   resolve_coefficient(state, dn, {f.level - 1, kc, lc}, refined);
+    refined[f] = sum;
+    ++state.stats.n_refined;
+    return sum;
+}
 
+SplineField unify_scales(ReceiverState& state, const DualTable& dn) {
+    const int m = state.options.m;
+    int j = 0;
+    for (const Fulcrum& f : state.fulcrums) j = std::max(j, f.level);
+    std::map<Fulcrum, Rgb> refined;  // coefficients obtained by (17), memoised
     SplineField field(m, j);
     const int first = first_touching_index(m), n = touching_count(m, j);
     for (int k = first; k < first + n; ++k)
-        for (int l = first; l < first + n; ++l) field.set_coefficient(k, l, coefficient({j, k, l}));
+        for (int l = first; l < first + n; ++l)
+            field.set_coefficient(k, l, resolve_coefficient(state, dn, {j, k, l}, refined));
     state.stats.level = j;
     return field;
 }
@@ -839,7 +912,7 @@ Shooter make_shooter(const Surface& surface, const SplineField& unshot, int leve
 
 SplineField transfer(const Shooter& shooter, const ReceiverSurface& receiver,
                      const ReceiverOptions& options, TransferStats* stats_out,
-                     ReceiverState* keep_state) {
+                     ReceiverState* keep_state, const OcclusionContext* occlusion) {
     MBR_CHECK_MSG(options.m >= 2 && options.m <= 8, "order m = " << options.m);
     MBR_CHECK(options.min_depth >= 0 && options.min_depth <= options.max_depth &&
               options.max_depth <= 14);
@@ -851,7 +924,11 @@ SplineField transfer(const Shooter& shooter, const ReceiverSurface& receiver,
     const DualTable dn(options.m);
     state.rhombus_radius = rhombus_radius_cells(options, dn);
     state.stats.rhombus_radius = state.rhombus_radius;
-    IncrementSampler sampler(shooter, receiver, options.quadrature);
+    // A pair that nothing can come between casts no rays and projects nothing.
+    state.occlusion = (occlusion && !occlusion->clear()) ? occlusion : nullptr;
+    const ShadowMethod shadows = state.occlusion ? options.shadows.method : ShadowMethod::None;
+    IncrementSampler sampler(shooter, receiver, options.quadrature,
+                             shadows == ShadowMethod::Exact ? state.occlusion : nullptr);
 
     auto t = std::chrono::steady_clock::now();
     subdivide_by_oracle(state, sampler);                                // stage 1
@@ -869,8 +946,15 @@ SplineField transfer(const Shooter& shooter, const ReceiverSurface& receiver,
     state.fulcrums = select_fulcrums(state.forest, options.m);          // stage 5
     state.stats.n_fulcrums = static_cast<int>(state.fulcrums.size());
     project_in_rhombi(state, dn);                                       // stage 6, eq. (19)
-    SplineField result = unify_scales(state, dn);                       // stage 8, eq. (17)
     state.stats.seconds_projection = seconds_since(t);
+    t = std::chrono::steady_clock::now();
+    if (shadows == ShadowMethod::Fractions) apply_shadows(state, sampler, dn);  // stage 7, (28)
+    state.stats.seconds_shadows = seconds_since(t);
+    t = std::chrono::steady_clock::now();
+    SplineField result = unify_scales(state, dn);                       // stage 8, eq. (17)
+    state.mask = nullptr;  // it refers to the sampler, which ends here
+    state.stats.seconds_projection += seconds_since(t);
+    state.stats.n_rays += sampler.n_rays();
     state.stats.seconds_total = seconds_since(start);
     if (stats_out) *stats_out = state.stats;
     return result;

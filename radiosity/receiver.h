@@ -15,9 +15,12 @@
 //                            "Extrapolation of Radiosity Distribution", eqs. (23)-(27)
 //   select_fulcrums          "Selection of Dual Basis Functions", Figure 2
 //   project_in_rhombi        "Projection", eq. (19), Figure 3
+//   apply_shadows            "Adaptive Subdivision in Shadow Computation", section 6
+//                            "Shadow", eq. (28) (radiosity/shadow_stage.cpp)
 //   unify_scales             "Scale Unification and Superposition", eq. (17)
 //
-// Shadows (VIS in (21), eq. (28)) are not part of this file yet: visibility is 1.
+// Visibility: with ShadowMethod::Fractions (the paper's) stage 7 masks the coefficients; with
+// ShadowMethod::Exact the samples of (21) already carry it (radiosity/shadow.h).
 #pragma once
 
 #include <array>
@@ -29,6 +32,7 @@
 #include "math/dual_basis.h"
 #include "radiosity/kernel.h"
 #include "radiosity/quadtree.h"
+#include "radiosity/shadow.h"
 #include "radiosity/spline_field.h"
 #include "radiosity/surface.h"
 
@@ -47,11 +51,19 @@ enum class EdgefillTest {
     Linearity      // the midpoint agrees with the chord: |dB(s3) - (dB(s1) + dB(s2)) / 2| small
 };
 
+/// How the oracle of stage 1 decides that a cell is "nearly sufficient".
+enum class OracleTest {
+    Means,          // the paper's: the means by ceil(m/2)^2 and m^2 Gauss-Legendre points agree
+    Interpolation   // beyond the paper: the polynomial through the m^2 samples predicts the
+                    //   ceil(m/2)^2 samples point by point (catches kinks the means hide)
+};
+
 struct ReceiverOptions {
     int m = 4;                         // B-spline order (the paper uses 4 and 3)
     int min_depth = 1;                 // oracle quadtree bounds; min = max = d gives the
     int max_depth = 6;                 //   uniform depth-d trees of Tables 1-2
     double oracle_tolerance = 1e-3;    // relative disagreement of the ceil(m/2)^2 and m^2 rules
+    OracleTest oracle_test = OracleTest::Means;
     double truncation_eps = 1e-7;      // relative cut-off of |DN x DN| that sets the rhombus
     double rhombus_radius = 0;         // in cells of the fulcrum's scale; 0: from truncation_eps
     Extrapolation extrapolation = Extrapolation::Linear;
@@ -72,6 +84,7 @@ struct ReceiverOptions {
     bool unify_by_projection = false;  // stage 8: project every finest-scale coefficient instead
                                        //   of refining coarse ones by (17) (not the paper's rule)
     QuadratureOptions quadrature;      // the adaptive rule over the shooter, section 6
+    ShadowOptions shadows;             // stage 7 (used when the transfer has occluders)
 };
 
 /// Counts and times of one transfer (summed after the parallel loops, so they do not depend
@@ -90,8 +103,11 @@ struct TransferStats {
     int n_refined = 0;              // coefficients obtained by (17) during unification
     int level = 0;                  // the unified level j of the result
     double rhombus_radius = 0;      // in cells
+    long n_rays = 0;                // shadow rays (fractions (28), or per node on curved shooters)
+    int n_fractions = 0;            // fractions (28) evaluated
+    int n_shadow_splits = 0;        // leaves split by shadow subdivision (and scale adjustment)
     double seconds_sampling = 0, seconds_boundary = 0, seconds_expanded = 0,
-           seconds_projection = 0, seconds_total = 0;
+           seconds_projection = 0, seconds_shadows = 0, seconds_total = 0;
 };
 
 /// The receiving surface: its geometry and its reflectance rho_i(s, t).
@@ -150,6 +166,12 @@ struct ReceiverState {
     std::map<Fulcrum, Rgb> coefficients;  // stage 6 (and on-demand ones from stage 8)
     double rhombus_radius = 0;            // in cells of each fulcrum's own scale
     std::shared_ptr<const ProjectionTables> tables;  // built by project_in_rhombi
+    const OcclusionContext* occlusion = nullptr;     // the pair's occluders (null: none)
+    std::map<std::pair<double, double>, Rgb> fractions;  // (28) at domain points (s, t)
+    /// Set by stage 7 while the transfer runs: the factor of a coefficient projected on demand
+    /// in stage 8 (its fulcrum's fraction), so that every coefficient of the result is masked.
+    std::function<Rgb(const Fulcrum&)> mask;
+    std::vector<Vec2> split_fulcrums;  // stage 7: fulcrums whose fractions split leaves
     TransferStats stats;
 };
 
@@ -157,8 +179,9 @@ struct ReceiverState {
 /// cache per thread.
 class IncrementSampler {
 public:
+    /// `occlusion` (may be null) puts VIS into (21): exact visibility (ShadowMethod::Exact).
     IncrementSampler(const Shooter& shooter, const ReceiverSurface& receiver,
-                     const QuadratureOptions& options);
+                     const QuadratureOptions& options, const OcclusionContext* occlusion = nullptr);
     /// dB at (s, t); `thread` selects the integrator (0 <= thread < n_threads()).
     Rgb sample(double s, double t, int thread, long* n_kernel_evals, bool* converged = nullptr);
     /// dB at (s, t) and at (s, t) + delta, the second on the first's shooter partition, for the
@@ -167,10 +190,17 @@ public:
                      long* n_kernel_evals);
     int n_threads() const { return static_cast<int>(integrators_.size()); }
     const ReceiverSurface& receiver() const { return receiver_; }
+    const Shooter& shooter() const { return shooter_; }
+    /// The integrator of one thread (the shadow stage asks it for shooter partitions).
+    IncrementIntegrator& integrator(int thread) { return *integrators_[thread]; }
+    /// Rays cast by the integrators' exact visibility so far (all threads).
+    long n_rays() const;
 
 private:
+    const Shooter& shooter_;
     const ReceiverSurface& receiver_;
     std::vector<std::unique_ptr<IncrementIntegrator>> integrators_;
+    std::vector<long> rays_;  // per thread
 };
 
 // ---- The stages, in the paper's order ----------------------------------------------------
@@ -204,6 +234,11 @@ Rgb extrapolate(const ReceiverState& state, double s, double t);
 /// Domain leaves that scale adjustment splits are sampled by (21).
 void expand_domain(ReceiverState& state, IncrementSampler& sampler);
 
+/// Samples for leaves made after stage 4 (shadow subdivision and its scale adjustment): a domain
+/// leaf gets its parent's tensor polynomial resampled (and is marked `resampled`), an expanded
+/// leaf the extrapolation.
+void sample_split_leaves(ReceiverState& state);
+
 /// Stage 5. Fulcrums (Figure 2): odd m, the centre of every domain leaf at the leaf's scale;
 /// even m, every corner of every domain leaf at that leaf's scale (a corner shared by leaves of
 /// two sizes carries two fulcrums); and the fulcrums of expanded leaves whose basis function
@@ -227,16 +262,44 @@ Rgb project(const ReceiverState& state, const DualTable& dn, const Fulcrum& f);
 Rgb project(const ReceiverState& state, const DualTable& dn, const ProjectionTables& tables,
             const Fulcrum& f);
 
+/// Stage 7 (the paper's shadows, ShadowMethod::Fractions): fractions (28) at the fulcrums of
+/// the domain leaves; leaves between neighbouring fulcrums whose fractions differ by more than
+/// the threshold are split (then NeighAdjust; their samples are resampled from the parent's
+/// polynomial), the new fulcrums' coefficients carried from the coarser ones by (17), until no
+/// leaf splits or the maximum shadow depth; then every stored coefficient is multiplied by its
+/// fulcrum's fraction. Does nothing without occluders. (radiosity/shadow_stage.cpp)
+void apply_shadows(ReceiverState& state, IncrementSampler& sampler, const DualTable& dn);
+
+/// Eq. (28) at the domain point (s, t): cast options.shadows.rays_per_patch rays to random
+/// points of every cell of the shooter partition the adaptive quadrature of (21) forms there;
+/// sum r_i e_i / sum e_i per channel (1 where nothing arrives). Memoised in state.fractions;
+/// the rays are seeded from the point and the pair's seed. `thread` picks the integrator.
+Rgb fraction_at(ReceiverState& state, IncrementSampler& sampler, double s, double t, int thread);
+
+/// The fraction a fulcrum's coefficient is masked with: at its position, or for a fulcrum
+/// outside the domain at the nearest point of the domain (DESIGN, docs/method.md).
+Vec2 fraction_point(const Fulcrum& f, int m);
+
+/// Stage 8's rule for one coefficient (shared with stage 7): a stored one is used; a missing one
+/// whose fulcrum's neighbourhood holds (21) samples at least as fine as its scale (or at level
+/// 0, or with unify_by_projection) is projected on demand (then stored, and masked with
+/// state.mask when set); otherwise it comes from (17) applied to the coefficients one level
+/// coarser, recursively (memoised in `refined`).
+Rgb resolve_coefficient(ReceiverState& state, const DualTable& dn, const Fulcrum& f,
+                        std::map<Fulcrum, Rgb>& refined);
+
 /// Stage 8. Every coefficient at the finest fulcrum scale 2^-j, for the basis functions that
 /// touch [0,1]^2: a stored one is used; a missing one at a fulcrum whose neighbourhood is at
 /// least as fine as its scale is projected on demand; otherwise it comes from (17) applied to
 /// the coefficients one level coarser, recursively.
 SplineField unify_scales(ReceiverState& state, const DualTable& dn);
 
-/// The whole transfer: dB_i of one shooting, as coefficients at one scale.
+/// The whole transfer: dB_i of one shooting, as coefficients at one scale. `occlusion` (may be
+/// null) names the pair's occluders; options.shadows.method says how they enter.
 SplineField transfer(const Shooter& shooter, const ReceiverSurface& receiver,
                      const ReceiverOptions& options, TransferStats* stats = nullptr,
-                     ReceiverState* keep_state = nullptr);
+                     ReceiverState* keep_state = nullptr,
+                     const OcclusionContext* occlusion = nullptr);
 
 /// The shooter as section 6 uses it: its unshot field coarsened by `levels` (not below 0).
 Shooter make_shooter(const Surface& surface, const SplineField& unshot, int levels);

@@ -6,6 +6,8 @@
 
 #include <vector>
 
+#include "math/vec3.h"
+
 #include "radiosity/spline_field.h"
 #include "radiosity/surface.h"
 
@@ -37,6 +39,31 @@ struct ErrorStats {
 /// the grid is evaluated in parallel.
 ErrorStats compare_with_exact(const SplineField& field, const TransferSetup& setup,
                               double shooter_radiosity = 1, double reflectance = 1, int n = 256);
+
+/// A shadowed transfer (issue "Shadows", example shadow_transfer): a shooter and a receiver,
+/// both planar quads with parallel planes, and convex planar occluders strictly between them.
+struct ShadowSetup {
+    Surface shooter;
+    Surface receiver;
+    std::vector<std::vector<Vec3>> occluders;  // convex polygons
+};
+/// Parallel unit squares at h = 1 (the receiver [0,1]^2 in z = 0) with an opaque square of side
+/// 0.4 centred at (0.5, 0.5, 0.5): parallel to both (tilt 0) or rotated by `tilt_degrees` about
+/// the x axis through its centre. `shooter_side` < 1 shrinks the shooter about its centre (an
+/// umbra appears below the occluder once the shooter is small enough).
+ShadowSetup occluded_squares(double tilt_degrees, double shooter_side = 1);
+
+/// The exact form factor from p (normal n_p) to a planar convex shooter polygon seen past one
+/// convex occluder lying strictly between p and the shooter's plane: F(shooter) minus
+/// F(shooter clipped to the occluder's central projection from p onto the shooter's plane), each
+/// by the analytic contour formula (machine precision).
+double shadowed_form_factor(Vec3 p, Vec3 n_p, const std::vector<Vec3>& shooter,
+                            const std::vector<Vec3>& occluder);
+
+/// The exact shadowed values (shooter radiosity 1, reflectance 1) on the n x n grid of cell
+/// centres of the receiver, row-major with s fastest. Occluders must not overlap as seen from
+/// any grid point (one at a time is subtracted).
+std::vector<double> exact_shadowed_grid(const ShadowSetup& setup, int n);
 
 /// The exact values on the same grid, row-major with s fastest (for pictures).
 std::vector<double> exact_grid(const TransferSetup& setup, int n, double scale = 1);

@@ -1,0 +1,58 @@
+// math/parallel.h - OpenMP loops whose failures reach the caller. An exception thrown inside an
+// OpenMP region must not leave it (the runtime would call std::terminate), so every body runs in
+// a try block; after the loop the exception of the lowest failing index is rethrown, which makes
+// the error reported independent of the thread count and the schedule.
+#pragma once
+
+#include <exception>
+#include <vector>
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+namespace mbr {
+
+/// The OpenMP thread number inside a parallel region (0 outside, or without OpenMP).
+inline int thread_index() {
+#ifdef _OPENMP
+    return omp_get_thread_num();
+#else
+    return 0;
+#endif
+}
+
+/// The number of threads a parallel region would use.
+inline int thread_count() {
+#ifdef _OPENMP
+    return omp_get_max_threads();
+#else
+    return 1;
+#endif
+}
+
+/// body(i) for i = 0 .. n-1 in parallel, items handed out one at a time (dynamic schedule);
+/// rethrows the exception of the lowest failing i once every item has run or failed.
+template <class Body>
+void parallel_for(int n, Body&& body) {
+    std::vector<std::exception_ptr> errors;
+    bool failed = false;
+#pragma omp parallel for schedule(dynamic, 1)
+    for (int i = 0; i < n; ++i) {
+        try {
+            body(i);
+        } catch (...) {
+#pragma omp critical(mbr_parallel_for_errors)
+            {
+                if (errors.empty()) errors.assign(static_cast<size_t>(n), nullptr);
+                errors[static_cast<size_t>(i)] = std::current_exception();
+                failed = true;
+            }
+        }
+    }
+    if (!failed) return;
+    for (const std::exception_ptr& e : errors)
+        if (e) std::rethrow_exception(e);
+}
+
+}  // namespace mbr

@@ -1,0 +1,304 @@
+// radiosity/shadow.cpp - occluders of a pair, shadow rays, and the exact visible part of a
+// planar shooter (the geometry of radiosity/shadow.h). The fractions (28) and the shadow
+// subdivision of stage 7 are in shadow_stage.cpp.
+#include "radiosity/shadow.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "math/check.h"
+
+namespace mbr {
+
+// ---- Seeds -------------------------------------------------------------------------------
+
+namespace {
+std::uint64_t splitmix(std::uint64_t x) {
+    x += 0x9e3779b97f4a7c15ULL;
+    x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ULL;
+    x = (x ^ (x >> 27)) * 0x94d049bb133111ebULL;
+    return x ^ (x >> 31);
+}
+}  // namespace
+
+std::uint64_t hash_seed(std::uint64_t a, std::uint64_t b, std::uint64_t c, std::uint64_t d) {
+    return splitmix(splitmix(splitmix(splitmix(a) ^ b) ^ c) ^ d);
+}
+
+double uniform01(std::uint64_t key, std::uint64_t index) {
+    return double(hash_seed(key, index) >> 11) * 0x1.0p-53;
+}
+
+// ---- Occluders of a pair -----------------------------------------------------------------
+
+std::vector<Vec3> hull_points(const Surface& surface) {
+    if (surface.kind() == Surface::Kind::PlanarQuad) {
+        const Vec3* c = surface.corners();
+        return {c[0], c[1], c[2], c[3]};
+    }
+    const Box3 b = surface.bounds();
+    std::vector<Vec3> out;
+    for (int i = 0; i < 8; ++i)
+        out.push_back(
+            {(i & 1) ? b.hi.x : b.lo.x, (i & 2) ? b.hi.y : b.lo.y, (i & 4) ? b.hi.z : b.lo.z});
+    return out;
+}
+
+namespace {
+
+/// An outward plane n . x <= d of a convex hull.
+struct HullPlane {
+    Vec3 n;
+    double d;
+};
+
+/// The supporting planes of the convex hull of a few points: every plane through three of them
+/// with all the others on its inner side (a flat hull gets its plane in both orientations).
+/// Brute force, for the 8 to 16 points of two surfaces.
+std::vector<HullPlane> hull_planes(const std::vector<Vec3>& pts, double tol) {
+    std::vector<HullPlane> planes;
+    const int n = static_cast<int>(pts.size());
+    for (int a = 0; a < n; ++a)
+        for (int b = a + 1; b < n; ++b)
+            for (int c = b + 1; c < n; ++c) {
+                Vec3 normal = cross(pts[b] - pts[a], pts[c] - pts[a]);
+                const double len = length(normal);
+                if (len <= tol * tol) continue;  // (nearly) collinear
+                normal = normal / len;
+                for (double sign : {1.0, -1.0}) {
+                    const Vec3 nn = sign * normal;
+                    const double d = dot(nn, pts[a]);
+                    bool supporting = true;
+                    for (const Vec3& q : pts)
+                        if (dot(nn, q) - d > tol) {
+                            supporting = false;
+                            break;
+                        }
+                    if (supporting) planes.push_back({nn, d});
+                }
+            }
+    return planes;
+}
+
+}  // namespace
+
+OcclusionContext make_occlusion_context(const Octree& octree, const Surface& shooter,
+                                        int shooter_surface, const Surface& receiver,
+                                        int receiver_surface, std::uint64_t shot) {
+    OcclusionContext ctx;
+    ctx.octree = &octree;
+    ctx.shooter_surface = shooter_surface;
+    ctx.receiver_surface = receiver_surface;
+    ctx.seed = hash_seed(std::uint64_t(shooter_surface), std::uint64_t(receiver_surface), shot);
+
+    std::vector<Vec3> pts = hull_points(shooter);
+    for (const Vec3& q : hull_points(receiver)) pts.push_back(q);
+    Box3 hull_box;
+    double scale = 0;
+    for (const Vec3& q : pts) {
+        hull_box.extend(q);
+        scale = std::max({scale, std::fabs(q.x), std::fabs(q.y), std::fabs(q.z)});
+    }
+    scale = std::max(scale, length(hull_box.extent()));
+    // DESIGN: 1e-9 of the coordinates: points that far off a hull plane count as on it, and a
+    // polygon that only touches the hull's boundary cannot block a segment inside it.
+    const double tol = 1e-9 * scale;
+    const std::vector<HullPlane> planes = hull_planes(pts, tol);
+
+    auto box_outside = [&](const Box3& box) {
+        if (!overlaps(box, hull_box)) return true;
+        for (const HullPlane& h : planes) {
+            // The corner furthest inside: all eight corners outside when even it is.
+            const Vec3 inner{h.n.x > 0 ? box.lo.x : box.hi.x, h.n.y > 0 ? box.lo.y : box.hi.y,
+                             h.n.z > 0 ? box.lo.z : box.hi.z};
+            if (dot(h.n, inner) - h.d > tol) return true;
+        }
+        return false;
+    };
+    const std::vector<int> near =
+        octree.polygons_near([&](const Box3& cube) { return !box_outside(cube); });
+    for (int id : near) {
+        const Polygon& poly = octree.polygons()[id];
+        if (poly.surface() == shooter_surface || poly.surface() == receiver_surface) continue;
+        if (box_outside(poly.bounds())) continue;
+        bool outside = false;
+        for (const HullPlane& h : planes) {
+            bool all_out = true;
+            for (const Vec3& v : poly.vertices())
+                if (dot(h.n, v) - h.d < -tol) {
+                    all_out = false;
+                    break;
+                }
+            if (all_out) {
+                outside = true;
+                break;
+            }
+        }
+        if (outside) continue;
+        // The polygon's own plane may separate: every hull point strictly on one side.
+        const Plane& pl = poly.plane();
+        bool pos = false, neg = false;
+        for (const Vec3& q : pts) {
+            const double s = pl.signed_distance(q);
+            if (s > tol) pos = true;
+            if (s < -tol) neg = true;
+        }
+        if (pos != neg) continue;  // one side only (or touching): the hull's inside is clear
+        ctx.candidates.push_back(id);
+    }
+    return ctx;
+}
+
+bool segment_blocked(const OcclusionContext& context, Vec3 a, Vec3 b, long* n_rays) {
+    if (context.candidates.empty()) return false;
+    if (n_rays) ++*n_rays;
+    // DESIGN: the open segment, t in [1e-9, 1 - 1e-9]: the end points lie on the two surfaces,
+    // which never block their own transfer anyway (their polygons are skipped).
+    const Ray ray{a, b - a, 1e-9, 1 - 1e-9};
+    if (context.candidates.size() <= 16) {
+        const std::vector<Polygon>& polys = context.octree->polygons();
+        for (int id : context.candidates)
+            if (polys[id].intersect(ray)) return true;
+        return false;
+    }
+    return context.octree->any_hit(ray,
+                                   RayFilter{context.shooter_surface, context.receiver_surface});
+}
+
+// ---- The visible part of a planar shooter ------------------------------------------------
+
+Vec2 ShooterPlane::at(double u, double v) const {
+    return (1 - u) * (1 - v) * corner[0] + u * (1 - v) * corner[1] + u * v * corner[2] +
+           (1 - u) * v * corner[3];
+}
+
+ShooterPlane make_shooter_plane(const Surface& quad) {
+    MBR_CHECK(quad.kind() == Surface::Kind::PlanarQuad);
+    const Vec3* c = quad.corners();
+    ShooterPlane sp;
+    sp.origin = 0.25 * (c[0] + c[1] + c[2] + c[3]);
+    // Newell's normal of the corners: the mean plane of a (slightly) non-planar quad.
+    Vec3 n{};
+    for (int i = 0; i < 4; ++i) n += cross(c[i], c[(i + 1) % 4]);
+    sp.normal = normalize(n);
+    sp.e1 = normalize(c[1] - c[0] - dot(c[1] - c[0], sp.normal) * sp.normal);
+    sp.e2 = cross(sp.normal, sp.e1);
+    for (int i = 0; i < 4; ++i) sp.corner[i] = sp.to_plane(c[i]);
+    sp.outline.assign(sp.corner, sp.corner + 4);
+    if (signed_area(sp.outline) < 0) std::reverse(sp.outline.begin(), sp.outline.end());
+    return sp;
+}
+
+BlockedView blocked_view(const ShooterPlane& plane, Vec3 p, Vec3 n_p,
+                         const OcclusionContext* context) {
+    BlockedView view;
+    // The horizon: the shooter's points x with n_p . (x - p) > 0 are in front of p.
+    view.front = HalfPlane{{dot(n_p, plane.e1), dot(n_p, plane.e2)}, dot(n_p, plane.origin - p)};
+    int n_front = 0, n_behind = 0;
+    for (const Vec2& q : plane.corner) {
+        const double v = view.front.value(q);
+        if (v > 0) ++n_front;
+        if (v < 0) ++n_behind;
+    }
+    if (n_front == 0) {
+        view.behind_all = true;
+        return view;
+    }
+    view.horizon_cuts = n_behind > 0;
+
+    const double h_p = dot(plane.normal, p - plane.origin);  // height of p above the plane
+    if (!context || context->candidates.empty() || h_p <= 0) return view;
+    const std::vector<Polygon>& polys = context->octree->polygons();
+    for (int id : context->candidates) {
+        // Keep the part of the occluder strictly between the plane and p (0 <= h < h_p), then
+        // project it from p: x -> p + h_p / (h_p - h(x)) (x - p).
+        const std::vector<Vec3>& vs = polys[id].vertices();
+        const int n = static_cast<int>(vs.size());
+        // DESIGN: occluder points within 1e-7 h_p of p's height are cut off: they could only
+        // block rays grazing the shooter's plane, and would project 1e7 times further out.
+        const double h_max = h_p * (1 - 1e-7);
+        std::vector<Vec3> slab;
+        slab.reserve(n + 4);
+        for (int i = 0; i < n; ++i) {
+            const Vec3 a = vs[i], b = vs[(i + 1) % n];
+            const double ha = dot(plane.normal, a - plane.origin);
+            const double hb = dot(plane.normal, b - plane.origin);
+            // Clip the edge to 0 <= h <= h_max (Sutherland-Hodgman against two planes at once:
+            // parameter range of the edge inside the slab).
+            auto inside = [&](double h) { return h >= 0 && h <= h_max; };
+            if (inside(ha)) slab.push_back(a);
+            double t0 = 0, t1 = 1;
+            const double dh = hb - ha;
+            if (dh != 0) {
+                double ta = (0 - ha) / dh, tb = (h_max - ha) / dh;
+                if (ta > tb) std::swap(ta, tb);
+                t0 = std::max(t0, ta);
+                t1 = std::min(t1, tb);
+            } else if (!inside(ha)) {
+                continue;
+            }
+            if (t0 > t1) continue;
+            // Entry and exit points strictly inside the edge.
+            if (t0 > 0 && t0 < 1) slab.push_back(a + t0 * (b - a));
+            if (t1 < 1 && t1 > t0 && t1 > 0) slab.push_back(a + t1 * (b - a));
+        }
+        if (slab.size() < 3) continue;
+        ConvexPolygon shadow;
+        shadow.reserve(slab.size());
+        for (const Vec3& x : slab) {
+            const double h = dot(plane.normal, x - plane.origin);
+            const Vec3 X = p + (h_p / (h_p - h)) * (x - p);
+            shadow.push_back(plane.to_plane(X));
+        }
+        const double area = signed_area(shadow);
+        if (area < 0) std::reverse(shadow.begin(), shadow.end());
+        if (std::fabs(area) <= 0) continue;  // an occluder seen edge-on hides nothing
+        shadow = intersect(shadow, plane.outline);
+        if (!shadow.empty()) view.shadows.push_back(std::move(shadow));
+    }
+    return view;
+}
+
+CellVisibility classify_cell(const ConvexPolygon& cell, const BlockedView& view) {
+    if (view.behind_all) return CellVisibility::hidden;
+    bool cut = false;
+    if (view.horizon_cuts) {
+        int n_front = 0, n_behind = 0;
+        for (const Vec2& q : cell) {
+            const double v = view.front.value(q);
+            if (v > 0) ++n_front;
+            if (v < 0) ++n_behind;
+        }
+        if (n_front == 0) return CellVisibility::hidden;
+        cut = n_behind > 0;
+    }
+    for (const ConvexPolygon& s : view.shadows) {
+        const Overlap o = classify(cell, s);
+        if (o == Overlap::inside) return CellVisibility::hidden;
+        if (o == Overlap::partial) cut = true;
+    }
+    return cut ? CellVisibility::cut : CellVisibility::clear;
+}
+
+std::vector<ConvexPolygon> visible_pieces(const ConvexPolygon& cell, const BlockedView& view) {
+    std::vector<ConvexPolygon> pieces;
+    ConvexPolygon first = view.horizon_cuts ? clip(cell, view.front) : cell;
+    if (first.empty()) return pieces;
+    pieces.push_back(std::move(first));
+    // DESIGN: slivers below 1e-14 of the cell's area are dropped (they hold no measurable
+    // energy and only cost quadrature points).
+    const double min_area = 1e-14 * std::fabs(signed_area(cell));
+    for (const ConvexPolygon& s : view.shadows) {
+        if (classify(cell, s) == Overlap::disjoint) continue;
+        std::vector<ConvexPolygon> next;
+        for (const ConvexPolygon& piece : pieces) {
+            std::vector<ConvexPolygon> rest = subtract(piece, s, min_area);
+            for (ConvexPolygon& r : rest) next.push_back(std::move(r));
+        }
+        pieces = std::move(next);
+        if (pieces.empty()) break;
+    }
+    return pieces;
+}
+
+}  // namespace mbr
