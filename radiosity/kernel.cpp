@@ -63,7 +63,6 @@ IncrementIntegrator::IncrementIntegrator(const Shooter& shooter, const Quadratur
     MBR_CHECK(options.n + 1 <= 64);
     unshot_bound_ = shooter.unshot.max_abs_coefficient();  // B-splines sum to one
     unshot_constant_ = shooter.unshot.is_constant();
-    pool_.reserve(1 << 20);  // 72 MB per thread at most; then the cache starts over
     unshot_values_.resize(size_t(options.n + 1) * (options.n + 1));
     rules_.resize(options.n + 2);
     for (int n = 1; n <= options.n + 1; ++n) rules_[n] = gauss_legendre(n);
@@ -83,8 +82,11 @@ IncrementIntegrator::PointSpan IncrementIntegrator::points(const QuadCell& cell,
                               (std::uint64_t(cell.j) << 1) | std::uint64_t(n == options_.n ? 0 : 1);
     auto it = cache_.find(key);
     if (it != cache_.end()) return {pool_.data() + it->second, n * n};
-    // Bound the cache (deep singular corners can make many cells); values never depend on it.
-    if (pool_.size() + size_t(n) * n > pool_.capacity()) {
+    // Bound the cache (deep singular corners can make many cells): at most max_cached_points
+    // (72 MB); then it starts over. Values never depend on it. The pool grows as needed, so a
+    // transfer that needs few points costs little memory (a span is used before the next call).
+    constexpr size_t max_cached_points = size_t(1) << 20;
+    if (pool_.size() + size_t(n) * n > max_cached_points) {
         cache_.clear();
         pool_.clear();
     }
@@ -223,10 +225,11 @@ IncrementIntegrator::Result IncrementIntegrator::integrate(const SurfacePoint& p
     const double scale = std::max(estimate, 1e-4 * unshot_bound_);
     AdaptiveOptions opt;
     opt.n = options_.n;
-    opt.tolerance = options_.rel_tolerance * scale;
+    opt.tolerance = std::max(options_.rel_tolerance * scale, options_.abs_tolerance);
     opt.max_depth = options_.max_depth;
     opt.min_depth = min_depth >= 0 ? std::min(min_depth, options_.max_depth) : options_.min_depth;
     opt.min_share = options_.min_share;
+    opt.global = options_.global;
     auto cell_rule = [&](const QuadCell& cell, int n) { return cell_value(p, cell, n); };
     // DESIGN: on a single cell the n- and (n+1)-point rules can agree by chance on a peaked
     // integrand, so the whole shooter is never accepted as one cell (min_depth = 1: with n = 6

@@ -45,11 +45,17 @@ struct Shooter {
 struct QuadratureOptions {
     int n = 6;                    // compare n x n with (n+1) x (n+1) Gauss-Legendre points
     double rel_tolerance = 1e-4;  // allowed error relative to a first estimate of the integral
+    double abs_tolerance = 0;     // and never below this absolute error (the integral's units:
+                                  //   radiosity); a scene sets it from its accuracy, so a weak
+                                  //   shot's partitions stay coarse
     int max_depth = 24;           // cap on the shooter's subdivision (at most 28)
     int min_depth = 1;            // the whole shooter is never accepted as one cell
     double min_share = 1e-6;      // floor of a cell's share of the tolerance (math/gauss_legendre.h)
     double near_field = 4.0;      // split a cell whose extent exceeds near_field times its
                                   //   distance from the receiving point (0: never)
+    bool global = false;          // refine the worst cell first until the error estimates sum
+                                  //   to the tolerance (AdaptiveOptions::global), instead of
+                                  //   the paper's quarter tolerance per child
     bool clip_horizon = true;     // planar shooters: integrate cells the receiving point's
                                   //   tangent plane cuts over their front part only (exact
                                   //   convex pieces), instead of chasing the kink of the

@@ -169,7 +169,8 @@ void subdivide_by_oracle(ReceiverState& state, IncrementSampler& sampler) {
                 largest = std::max(largest, max_abs(f_c[a * nc + b]));
             }
         *increments += m * m + nc * nc;
-        const double tol = opt.oracle_tolerance * std::max(largest, 0.01 * scale);
+        const double tol =
+            std::max(opt.oracle_tolerance * std::max(largest, 0.01 * scale), opt.absolute_tolerance);
         for (int a = 0; a < nc; ++a)
             for (int b = 0; b < nc; ++b) {
                 Rgb p;
@@ -216,7 +217,8 @@ void subdivide_by_oracle(ReceiverState& state, IncrementSampler& sampler) {
             const Rgb fine = cell_mean(cell.rect(), rule_m, th, &evals[c], &increments[c]);
             // DESIGN: relative agreement, with a floor at 1% of the largest value in the domain
             // so that nearly dark cells do not split forever.
-            const double tol = opt.oracle_tolerance * std::max(max_abs(fine), 0.01 * scale);
+            const double tol = std::max(opt.oracle_tolerance * std::max(max_abs(fine), 0.01 * scale),
+                                        opt.absolute_tolerance);
             action[c] = max_abs(fine - coarse) <= tol ? SplitOnceMore : Split;
         });
         std::vector<int> next;
@@ -371,7 +373,7 @@ void fill_boundary(ReceiverState& state, IncrementSampler& sampler) {
         profile.h_min = finest_leaf_on_edge(state.forest, e);
         delta = opt.divided_difference_step * profile.h_min;
         inset = opt.boundary_inset * profile.h_min;
-        const double v_tol = opt.edgefill_tolerance * state.max_sample;
+        const double v_tol = std::max(opt.edgefill_tolerance * state.max_sample, opt.absolute_tolerance);
         const double d_tol = v_tol / profile.h_min;
 
         long evals = 0;
@@ -912,7 +914,8 @@ Shooter make_shooter(const Surface& surface, const SplineField& unshot, int leve
 
 SplineField transfer(const Shooter& shooter, const ReceiverSurface& receiver,
                      const ReceiverOptions& options, TransferStats* stats_out,
-                     ReceiverState* keep_state, const OcclusionContext* occlusion) {
+                     ReceiverState* keep_state, const OcclusionContext* occlusion,
+                     const DualTable* dual) {
     MBR_CHECK_MSG(options.m >= 2 && options.m <= 8, "order m = " << options.m);
     MBR_CHECK(options.min_depth >= 0 && options.min_depth <= options.max_depth &&
               options.max_depth <= 14);
@@ -921,9 +924,13 @@ SplineField transfer(const Shooter& shooter, const ReceiverSurface& receiver,
     ReceiverState& state = keep_state ? *keep_state : local;
     state = ReceiverState{};
     state.options = options;
-    const DualTable dn(options.m);
+    std::unique_ptr<DualTable> own_dual;
+    if (!dual || dual->order() != options.m) {
+        own_dual = std::make_unique<DualTable>(options.m);
+        dual = own_dual.get();
+    }
+    const DualTable& dn = *dual;
     state.rhombus_radius = rhombus_radius_cells(options, dn);
-    state.stats.rhombus_radius = state.rhombus_radius;
     // A pair that nothing can come between casts no rays and projects nothing.
     state.occlusion = (occlusion && !occlusion->clear()) ? occlusion : nullptr;
     const ShadowMethod shadows = state.occlusion ? options.shadows.method : ShadowMethod::None;
@@ -935,6 +942,13 @@ SplineField transfer(const Shooter& shooter, const ReceiverSurface& receiver,
     adjust_neighbour_scales(state.forest, Forest::Region::Domain);      // stage 2
     sample_leaves(state, sampler);                                      //   eq. (21)
     state.stats.n_leaves = static_cast<int>(state.forest.leaves(Forest::Region::Domain).size());
+    if (options.absolute_tolerance > 0 && options.rhombus_radius <= 0 && state.max_sample > 0) {
+        // DESIGN: a weak shot needs no more truncation accuracy than the scene's tolerance.
+        const double eps = std::clamp(options.absolute_tolerance / state.max_sample,
+                                      options.truncation_eps, std::max(options.truncation_eps, 1e-3));
+        state.rhombus_radius = dn.rhombus_radius(eps);
+    }
+    state.stats.rhombus_radius = state.rhombus_radius;
     state.stats.seconds_sampling = seconds_since(t);
     t = std::chrono::steady_clock::now();
     fill_boundary(state, sampler);                                      // stage 3, eq. (22)

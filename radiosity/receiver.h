@@ -85,6 +85,13 @@ struct ReceiverOptions {
                                        //   of refining coarse ones by (17) (not the paper's rule)
     QuadratureOptions quadrature;      // the adaptive rule over the shooter, section 6
     ShadowOptions shadows;             // stage 7 (used when the transfer has occluders)
+    double absolute_tolerance = 0;     // radiosity below which differences never refine: the
+                                       //   oracle, edgefill and shadow tests use the larger of
+                                       //   their relative tolerance and this, and the truncation
+                                       //   eps grows to absolute_tolerance / max|dB| (at most
+                                       //   1e-3). 0: relative tests only (single transfers); a
+                                       //   scene sets it from its accuracy option, so that cost
+                                       //   follows the energy of each shot
 };
 
 /// Counts and times of one transfer (summed after the parallel loops, so they do not depend
@@ -295,11 +302,13 @@ Rgb resolve_coefficient(ReceiverState& state, const DualTable& dn, const Fulcrum
 SplineField unify_scales(ReceiverState& state, const DualTable& dn);
 
 /// The whole transfer: dB_i of one shooting, as coefficients at one scale. `occlusion` (may be
-/// null) names the pair's occluders; options.shadows.method says how they enter.
+/// null) names the pair's occluders; options.shadows.method says how they enter. `dual` (may be
+/// null) is DN_m for options.m, built once by a caller that runs many transfers.
 SplineField transfer(const Shooter& shooter, const ReceiverSurface& receiver,
                      const ReceiverOptions& options, TransferStats* stats = nullptr,
                      ReceiverState* keep_state = nullptr,
-                     const OcclusionContext* occlusion = nullptr);
+                     const OcclusionContext* occlusion = nullptr,
+                     const DualTable* dual = nullptr);
 
 /// The shooter as section 6 uses it: its unshot field coarsened by `levels` (not below 0).
 Shooter make_shooter(const Surface& surface, const SplineField& unshot, int levels);

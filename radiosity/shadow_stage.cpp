@@ -147,6 +147,9 @@ void apply_shadows(ReceiverState& state, IncrementSampler& sampler, const DualTa
     const int m = opt.m;
     Forest& forest = state.forest;
     const double inset = opt.boundary_inset * finest_domain_leaf(forest);
+    // Fractions that differ by more than the threshold split, unless the difference they make
+    // is below the scene's absolute tolerance (a weak shot keeps coarse shadows).
+    const double threshold = std::max(so.threshold, state.max_sample > 0 ? opt.absolute_tolerance / state.max_sample : 0.0);
 
     std::set<int> new_leaves;  // domain leaves made by shadow subdivision (node indices)
     for (;;) {
@@ -172,7 +175,7 @@ void apply_shadows(ReceiverState& state, IncrementSampler& sampler, const DualTa
                 const std::vector<Fulcrum> f = leaf_fulcrums(c, m);  // (0,0) (1,0) (0,1) (1,1)
                 const int edges[4][2] = {{0, 1}, {1, 3}, {3, 2}, {2, 0}};
                 for (const auto& e : edges)
-                    if (difference(phi(f[e[0]]), phi(f[e[1]])) > so.threshold) {
+                    if (difference(phi(f[e[0]]), phi(f[e[1]])) > threshold) {
                         marked.insert(index);
                         if (c.level < so.max_depth) {
                             state.split_fulcrums.push_back(fraction_point(f[e[0]], m));
@@ -196,7 +199,7 @@ void apply_shadows(ReceiverState& state, IncrementSampler& sampler, const DualTa
                     const Fulcrum of = leaf_fulcrums(forest.node(other).cell, m)[0];
                     if (!state.fractions.count({fraction_point(of, m).x, fraction_point(of, m).y}))
                         continue;  // a leaf of an earlier round's scale adjustment: next round
-                    if (difference(phi(own), phi(of)) > so.threshold) {
+                    if (difference(phi(own), phi(of)) > threshold) {
                         marked.insert(index);
                         marked.insert(other);
                         state.split_fulcrums.push_back(fraction_point(own, m));

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "math/check.h"
 #include "math/gauss_legendre.h"
@@ -53,22 +54,28 @@ Rgb SplineField::evaluate(double s, double t) const {
 
 void SplineField::evaluate_grid(const double* s, int n_s, const double* t, int n_t,
                                 Rgb* out) const {
-    MBR_CHECK(n_t <= 64);
+    MBR_CHECK(n_t >= 1 && n_t <= 64);
     const CoefficientGrid& g0 = grid_[0];
     double bs[16], bt[64][16];
     int fl[64];
     for (int b = 0; b < n_t; ++b) fl[b] = bspline_values(m_, std::ldexp(t[b], level_), bt[b]);
+    // The l needed by any t: one row of that many sums per s (any level: no fixed bound).
+    int l_lo = fl[0], l_hi = fl[0];
+    for (int b = 1; b < n_t; ++b) {
+        l_lo = std::min(l_lo, fl[b]);
+        l_hi = std::max(l_hi, fl[b]);
+    }
+    l_hi += m_ - 1;
+    Rgb small[96];
+    std::vector<Rgb> large;
+    Rgb* row = small;
+    if (l_hi - l_lo + 1 > 96) {
+        large.resize(size_t(l_hi - l_lo + 1));
+        row = large.data();
+    }
     for (int a = 0; a < n_s; ++a) {
         const int fk = bspline_values(m_, std::ldexp(s[a], level_), bs);
         // row[l] = sum_k c_{k,l} N_m(2^j s_a - k) over the m values of k, for every l needed.
-        int l_lo = fl[0], l_hi = fl[0];
-        for (int b = 1; b < n_t; ++b) {
-            l_lo = std::min(l_lo, fl[b]);
-            l_hi = std::max(l_hi, fl[b]);
-        }
-        l_hi += m_ - 1;
-        Rgb row[96];
-        MBR_CHECK(l_hi - l_lo + 1 <= 96);
         for (int l = l_lo; l <= l_hi; ++l) {
             Rgb sum;
             if (l >= g0.first_l && l < g0.first_l + g0.n_l)

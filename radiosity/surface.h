@@ -60,6 +60,10 @@ public:
     SurfacePoint evaluate(double u, double v) const;
     /// True when the surface lies in one plane (planar quads and disks).
     bool is_planar() const { return kind_ == Kind::PlanarQuad || kind_ == Kind::Disk; }
+    /// True for a cylinder or sphere patch facing inward: its points can see each other.
+    bool is_concave() const {
+        return inward_ && (kind_ == Kind::Cylinder || kind_ == Kind::Sphere);
+    }
     /// Total area, the integral of A over [0,1]^2 (closed form where one exists).
     double area() const;
     /// A box containing the whole surface.

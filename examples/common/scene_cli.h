@@ -1,0 +1,47 @@
+// examples/common/scene_cli.h - what every whole-scene program shares: reading a scene and the
+// solver options (the scene's `set` statements, overridden by the command line), solving with
+// a progress line, and printing the statistics of a run.
+#pragma once
+
+#include <iosfwd>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "examples/common/cli.h"
+#include "octree/octree.h"
+#include "radiosity/scene.h"
+#include "radiosity/solver.h"
+
+namespace mbr {
+
+/// Usage lines of the options read_scene_run understands.
+extern const char* solver_options_usage;
+
+/// A scene to solve, with its options and octree.
+struct SceneRun {
+    std::string path;
+    Scene scene;
+    SolverOptions options;
+    int threads = 0;                 // 0: OpenMP's default
+    bool quiet = false;              // no progress bar
+    std::unique_ptr<Octree> octree;  // over scene_polygons(scene, settings.tessellation)
+};
+
+/// Reads the solver options (--order, --min-depth, --max-depth, --shots, --tolerance,
+/// --convergence, --shadows, --rays, --threads, --quiet, ...), then the scene path (the one
+/// positional argument, or `default_scene` when empty and none is given), loads the scene and
+/// builds its octree. Call it after reading the program's own options.
+SceneRun read_scene_run(Args& args, const std::string& default_scene);
+
+/// Solves, with a progress bar on stderr when it is a terminal and `progress` is set.
+Solution solve_scene(SceneRun& run, bool progress);
+
+/// One line per shot.
+void print_shots(std::ostream& os, const Scene& scene, const SolveStats& stats);
+/// The run's statistics as text.
+void print_summary(std::ostream& os, const SceneRun& run, const SolveStats& stats);
+/// shots, unshot_percent, seconds, peak_mib, coefficients.
+std::vector<std::string> summary_cells(const SolveStats& stats);
+
+}  // namespace mbr
