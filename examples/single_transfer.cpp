@@ -52,27 +52,11 @@ int run(mbr::Args& args) {
     const TransferSetup defaults = parallel_squares(1.0);
     TransferSetup setup{read_quad(args, "--shooter", defaults.shooter),
                         read_quad(args, "--receiver", defaults.receiver)};
-    ReceiverOptions options = read_receiver_options(args);
-    const bool adaptive = args.flag("--adaptive");
-    const int depth = args.integer("--depth", 3, 0, 12);
-    options.oracle_tolerance = args.number("--oracle-tolerance", options.oracle_tolerance);
-    options.min_depth = args.integer("--min-depth", options.min_depth, 0, 12);
-    options.max_depth = args.integer("--max-depth", options.max_depth, 0, 12);
+    const bool adaptive = args.has("--adaptive");
+    const ReceiverOptions options = read_tree_options(args, read_receiver_options(args));
     const int grid = args.integer("--grid", 256, 2, 4096);
     const bool csv = args.flag("--csv");
     args.finish();
-    // Each mode refuses the options of the other rather than ignoring them.
-    if (adaptive && args.has("--depth"))
-        throw UsageError("--depth has no effect with --adaptive: the adaptive tree is bounded by "
-                         "--min-depth and --max-depth");
-    if (!adaptive) {
-        if (args.has("--min-depth") || args.has("--max-depth") || args.has("--oracle-tolerance"))
-            throw UsageError("--min-depth, --max-depth and --oracle-tolerance need --adaptive");
-        options.min_depth = options.max_depth = depth;
-    }
-    if (options.min_depth > options.max_depth)
-        throw UsageError("--min-depth must not exceed --max-depth");
-    if (!(options.oracle_tolerance > 0)) throw UsageError("--oracle-tolerance must be positive");
     // The two fronts must face each other somewhere, or nothing is transferred.
     const SurfacePoint centre = setup.receiver.evaluate(0.5, 0.5);
     const SurfacePoint source = setup.shooter.evaluate(0.5, 0.5);
@@ -95,7 +79,7 @@ int run(mbr::Args& args) {
               << (adaptive ? "  adaptive receiver tree, oracle tolerance " + cell_g(options.oracle_tolerance, 3) +
                                  ", depths " + std::to_string(options.min_depth) + ".." +
                                  std::to_string(options.max_depth)
-                           : "  uniform receiver depth " + std::to_string(depth))
+                           : "  uniform receiver depth " + std::to_string(options.max_depth))
               << "\n\n";
     table.write_text(std::cout);
     std::cout << "\n  unified level j = " << s.level << " (" << run.n_coefficients

@@ -55,6 +55,26 @@ ReceiverOptions read_receiver_options(Args& args) {
     return o;
 }
 
+ReceiverOptions read_tree_options(Args& args, ReceiverOptions o) {
+    const bool adaptive = args.flag("--adaptive");
+    const int depth = args.integer("--depth", 3, 0, 12);
+    o.oracle_tolerance = args.number("--oracle-tolerance", o.oracle_tolerance);
+    o.min_depth = args.integer("--min-depth", o.min_depth, 0, 12);
+    o.max_depth = args.integer("--max-depth", o.max_depth, 0, 12);
+    // Each mode refuses the options of the other rather than ignoring them.
+    if (adaptive && args.has("--depth"))
+        throw UsageError("--depth has no effect with --adaptive: the adaptive tree is bounded by "
+                         "--min-depth and --max-depth");
+    if (!adaptive) {
+        if (args.has("--min-depth") || args.has("--max-depth") || args.has("--oracle-tolerance"))
+            throw UsageError("--min-depth, --max-depth and --oracle-tolerance need --adaptive");
+        o.min_depth = o.max_depth = depth;
+    }
+    if (o.min_depth > o.max_depth) throw UsageError("--min-depth must not exceed --max-depth");
+    if (!(o.oracle_tolerance > 0)) throw UsageError("--oracle-tolerance must be positive");
+    return o;
+}
+
 std::string describe(const ReceiverOptions& o) {
     std::ostringstream os;
     const char* extrapolation = o.extrapolation == Extrapolation::Linear      ? "linear (23)-(25)"
