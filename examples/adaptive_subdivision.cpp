@@ -21,7 +21,7 @@ std::string usage() {
                "usage: adaptive_subdivision [--h H] [--max-depth D] [--csv] [options]\n"
                "  rea against leaves: uniform depths 2..5 and the oracle at several thresholds.\n"
                "  --h H          distance of the parallel unit squares (default 0.1)\n"
-               "  --max-depth D  depth cap of the adaptive trees (default 5)\n"
+               "  --max-depth D  depth cap of the adaptive trees, 2..8 (default 5)\n"
                "  --csv          header tree,unification,oracle_tolerance,leaves,samples,"
                "rea_percent,seconds\n") +
            mbr::receiver_options_usage;
@@ -30,12 +30,11 @@ std::string usage() {
 int run(mbr::Args& args) {
     using namespace mbr;
     const double h = args.number("--h", 0.1);
-    const int max_depth = args.integer("--max-depth", 5);
+    const int max_depth = args.integer("--max-depth", 5, 2, 8);
     const bool csv = args.flag("--csv");
     ReceiverOptions base = read_receiver_options(args);
     args.finish();
     if (!(h > 0 && h < 100)) throw UsageError("--h must be in (0, 100)");
-    if (max_depth < 2 || max_depth > 8) throw UsageError("--max-depth must be between 2 and 8");
     const TransferSetup setup = parallel_squares(h);
 
     Table table({"tree", "unification", "oracle_tolerance", "leaves", "samples", "rea_percent", "seconds"});

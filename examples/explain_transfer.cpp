@@ -22,12 +22,14 @@
 // the finest-scale fulcrum on the bottom edge nearest its middle; --fulcrum-index picks any other
 // (indices as printed: sorted by level, then k, then l). stdout gets the summary: leaves per level
 // in the domain and the ring, splits made by scale adjustment, edgefill nodes per edge, fulcrums
-// per level, coincident pairs, the rhombus radius and the rea of the transfer. A bad option or an
-// unwritable file gives one error line and exit 2, and no partial image (write_png renames a
-// finished file).
+// per level, coincident pairs, the rhombus radius and the rea of the transfer (on stderr when
+// the image itself goes to stdout, -o /dev/stdout). A bad option gives one error line and exit
+// 2; an output path that cannot be written one line and exit 1, before the transfer is run when
+// the path is already wrong (a missing or read-only folder, a directory), and no partial image
+// ever (radiosity/output_file.h).
 #include <algorithm>
+#include <climits>
 #include <cmath>
-#include <filesystem>
 #include <iostream>
 #include <map>
 #include <set>
@@ -37,6 +39,7 @@
 #include "examples/common/cli.h"
 #include "examples/common/plot.h"
 #include "examples/common/transfer_cli.h"
+#include "radiosity/output_file.h"
 
 namespace mbr {
 namespace {
@@ -50,7 +53,7 @@ std::string usage() {
                "  -o FILE.png                output image (required)\n"
                "  --h H                      parallel unit squares at distance H (default 0.1)\n"
                "  --perpendicular            perpendicular unit squares instead\n"
-               "  --min-depth D              oracle quadtree bounds (default 1 and 4)\n"
+               "  --min-depth D              oracle quadtree bounds, 0..7 (default 1 and 4)\n"
                "  --max-depth D\n"
                "  --oracle-tolerance T       oracle threshold (default 3e-3)\n"
                "  --fulcrum-index I          fulcrum of the rhombus panel (default: the finest\n"
@@ -657,22 +660,20 @@ int run(Args& args) {
     const bool perpendicular = args.flag("--perpendicular");
     const double h = args.number("--h", 0.1);
     ReceiverOptions options = read_receiver_options(args);
-    options.min_depth = args.integer("--min-depth", 1);
-    options.max_depth = args.integer("--max-depth", 4);
+    options.min_depth = args.integer("--min-depth", 1, 0, 7);
+    options.max_depth = args.integer("--max-depth", 4, 0, 7);
     options.oracle_tolerance = args.number("--oracle-tolerance", 3e-3);
-    const int fulcrum_index = args.integer("--fulcrum-index", -1);
+    // The upper end depends on the transfer; it is checked once the fulcrums are known.
+    const int fulcrum_index = args.integer("--fulcrum-index", -1, 0, INT_MAX);
     args.finish();
     if (path.empty()) throw UsageError("-o FILE.png is required");
     if (perpendicular && args.has("--h"))
         throw UsageError("--h and --perpendicular exclude each other");
     if (!(h > 0 && h <= 10)) throw UsageError("--h must be in (0, 10]");
-    if (options.min_depth < 0 || options.max_depth > 7 || options.min_depth > options.max_depth)
-        throw UsageError("depths must satisfy 0 <= --min-depth <= --max-depth <= 7");
+    if (options.min_depth > options.max_depth)
+        throw UsageError("--min-depth must not exceed --max-depth");
     if (!(options.oracle_tolerance > 0)) throw UsageError("--oracle-tolerance must be positive");
-
-    const std::filesystem::path parent = std::filesystem::path(path).parent_path();
-    if (!parent.empty() && !std::filesystem::is_directory(parent))
-        throw InputError(path, 0, "the folder of the output file does not exist");
+    check_output_path(path);  // fail now, not after the transfer
 
     const TransferSetup setup = perpendicular ? perpendicular_squares() : parallel_squares(h);
     const std::string geometry =
@@ -689,40 +690,42 @@ int run(Args& args) {
     const Image image = compose(E, counts, chosen);
     write_png(path, image);
 
+    // The report goes on stderr when the image went to stdout, so that the two do not mix.
+    std::ostream& report = is_standard_output(path) ? std::cerr : std::cout;
     const int m = options.m;
     const Fulcrum& cf = st.fulcrums[chosen];
     const Vec2 q = cf.position(m);
-    std::cout << "explain_transfer: " << geometry << "\n  " << describe(options)
-              << "\n  oracle depths " << options.min_depth << ".." << options.max_depth
-              << ", tolerance " << options.oracle_tolerance << "\n\n"
-              << "stage 1-2  domain leaves per level:   " << per_level(counts.domain_leaves)
-              << "  (NeighAdjust splits: " << E.n_adjust_splits
-              << "; further domain leaves from the ring's scale adjustment: "
-              << E.n_domain_after_ring << ")\n"
-              << "stage 3    edgefill nodes per edge:   bottom " << st.edges[0].sigma.size()
-              << ", right " << st.edges[1].sigma.size() << ", top " << st.edges[2].sigma.size()
-              << ", left " << st.edges[3].sigma.size() << "\n"
-              << "stage 4    ring: " << st.forest.extent() << " units wide on each side, "
-              << "expanded leaves per level: " << per_level(counts.ring_leaves) << "\n"
-              << "stage 5    fulcrums per level:        " << per_level(counts.fulcrums)
-              << "  (outside [0,1]^2: " << per_level(counts.fulcrums_outside) << ")\n"
-              << "           coincident pairs:          " << counts.coincident_pairs
-              << " corners carry fulcrums of two scales\n"
-              << "stage 6    rhombus radius:            " << cell_g(st.rhombus_radius, 4)
-              << " cells of each fulcrum's scale";
+    report << "explain_transfer: " << geometry << "\n  " << describe(options)
+           << "\n  oracle depths " << options.min_depth << ".." << options.max_depth
+           << ", tolerance " << options.oracle_tolerance << "\n\n"
+           << "stage 1-2  domain leaves per level:   " << per_level(counts.domain_leaves)
+           << "  (NeighAdjust splits: " << E.n_adjust_splits
+           << "; further domain leaves from the ring's scale adjustment: " << E.n_domain_after_ring
+           << ")\n"
+           << "stage 3    edgefill nodes per edge:   bottom " << st.edges[0].sigma.size()
+           << ", right " << st.edges[1].sigma.size() << ", top " << st.edges[2].sigma.size()
+           << ", left " << st.edges[3].sigma.size() << "\n"
+           << "stage 4    ring: " << st.forest.extent() << " units wide on each side, "
+           << "expanded leaves per level: " << per_level(counts.ring_leaves) << "\n"
+           << "stage 5    fulcrums per level:        " << per_level(counts.fulcrums)
+           << "  (outside [0,1]^2: " << per_level(counts.fulcrums_outside) << ")\n"
+           << "           coincident pairs:          " << counts.coincident_pairs
+           << " corners carry fulcrums of two scales\n"
+           << "stage 6    rhombus radius:            " << cell_g(st.rhombus_radius, 4)
+           << " cells of each fulcrum's scale";
     for (const auto& [l, n] : counts.fulcrums)
-        std::cout << (l == counts.fulcrums.begin()->first ? " (= " : ", ")
-                  << cell_g(std::ldexp(st.rhombus_radius, -l), 4) << " at L" << l;
-    std::cout << ")\n"
-              << "           rhombi reaching past the ring (cut there): "
-              << per_level(counts.beyond_ring) << "\n"
-              << "           panel (d): fulcrum #" << chosen << " = level " << cf.level
-              << ", k = " << cf.k << ", l = " << cf.l << ", at (s, t) = (" << q.x << ", " << q.y
-              << ")\n"
-              << "result     rea = " << cell_g(100 * E.errors.rea, 4)
-              << " %, max relative error = " << cell_g(100 * E.errors.max_rel, 4) << " %, "
-              << cell(E.seconds, 2) << " s\n"
-              << "wrote " << path << " (" << image.width << " x " << image.height << ")\n";
+        report << (l == counts.fulcrums.begin()->first ? " (= " : ", ")
+               << cell_g(std::ldexp(st.rhombus_radius, -l), 4) << " at L" << l;
+    report << ")\n"
+           << "           rhombi reaching past the ring (cut there): "
+           << per_level(counts.beyond_ring) << "\n"
+           << "           panel (d): fulcrum #" << chosen << " = level " << cf.level
+           << ", k = " << cf.k << ", l = " << cf.l << ", at (s, t) = (" << q.x << ", " << q.y
+           << ")\n"
+           << "result     rea = " << cell_g(100 * E.errors.rea, 4)
+           << " %, max relative error = " << cell_g(100 * E.errors.max_rel, 4) << " %, "
+           << cell(E.seconds, 2) << " s\n"
+           << "wrote " << path << " (" << image.width << " x " << image.height << ")\n";
     return 0;
 }
 

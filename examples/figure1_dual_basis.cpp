@@ -13,8 +13,9 @@
 // symmetric about the fulcrum; the first negative lobes reach -0.67 and -1.06.
 // stdout gets a short table of what was measured from the tables: max |DN_m| and where, the
 // first zero crossings to the right of the fulcrum (those on the left mirror them), and the
-// extreme of the first negative lobe. A bad command line or an unwritable file gives one error
-// line and exit code 2, and leaves no partial file (write_png renames a finished temporary).
+// extreme of the first negative lobe (on stderr when the image goes to stdout). A bad command
+// line gives one error line and exit code 2; an output path that cannot be written one line and
+// exit code 1, and never a partial file (radiosity/output_file.h).
 #include <algorithm>
 #include <cmath>
 #include <iostream>
@@ -24,6 +25,7 @@
 #include "examples/common/cli.h"
 #include "examples/common/plot.h"
 #include "math/dual_basis.h"
+#include "radiosity/output_file.h"
 
 namespace mbr {
 namespace {
@@ -121,14 +123,11 @@ std::string list(const std::vector<double>& v, size_t n, int digits) {
 
 int run(Args& args) {
     const std::string path = args.text("-o", "");
-    const int width = args.integer("--width", 1200);
-    const int height = args.integer("--height", 500);
+    const int width = args.integer("--width", 1200, 400, 8000);
+    const int height = args.integer("--height", 500, 200, 8000);
     args.finish();
     if (path.empty()) throw UsageError("-o FILE.png is required");
-    if (width < 400 || width > 8000)
-        throw UsageError("--width must be in 400..8000, got " + std::to_string(width));
-    if (height < 200 || height > 8000)
-        throw UsageError("--height must be in 200..8000, got " + std::to_string(height));
+    check_output_path(path);
 
     Image image(width, height, {1, 1, 1});
     const int half = width / 2;
@@ -140,16 +139,18 @@ int run(Args& args) {
                                     {0.80, 0.20, 0.15}, text_scale);
     write_png(path, image);
 
-    std::cout << "Figure 1: dual scaling functions DN_3 and DN_4 -> " << path << " (" << width
-              << " x " << height << ")\n"
-              << "each panel: x in fulcrum +/- " << half_range << ", " << n_samples
-              << " samples of the DualTable\n";
+    // The report goes on stderr when the image went to stdout, so that the two do not mix.
+    std::ostream& report = is_standard_output(path) ? std::cerr : std::cout;
+    report << "Figure 1: dual scaling functions DN_3 and DN_4 -> " << path << " (" << width << " x "
+           << height << ")\n"
+           << "each panel: x in fulcrum +/- " << half_range << ", " << n_samples
+           << " samples of the DualTable\n";
     Table table({"m", "fulcrum", "max|DN_m|", "at_x", "first_zeros_right_of_fulcrum",
                  "first_negative_lobe_min"});
     for (const Measured& r : {dn3, dn4})
         table.add_row({std::to_string(r.m), cell(r.fulcrum, 1), cell(r.max_abs, 6),
                        cell(r.argmax, 3), list(r.zeros, 4, 4), cell(r.first_min, 4)});
-    table.write_text(std::cout);
+    table.write_text(report);
     return 0;
 }
 

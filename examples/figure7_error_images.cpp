@@ -24,12 +24,12 @@
 // shared edge t = 0, where the form factor's derivatives are singular; full red at 5 %
 // (magnification 20), about 380 points (0.58 %) beyond, drawn black.
 // stdout: per image the configuration, rea, max relative error and where, the colour ranges
-// and the file written. A bad option or a missing directory gives one error line and exit 2;
-// both images are rendered before either is written, each file is written atomically, and
-// if the second cannot be written the first is removed again.
+// and the file written. A bad option gives one error line and exit 2; a folder that is missing,
+// read-only or not a folder one line and exit 1, before anything is computed. Both images are
+// rendered and both written to temporaries before either file is replaced (write_files in
+// radiosity/output_file.h), so a full disk leaves both old files as they were.
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <filesystem>
 #include <iostream>
 #include <string>
@@ -38,6 +38,7 @@
 #include "examples/common/cli.h"
 #include "examples/common/plot.h"
 #include "examples/common/transfer_cli.h"
+#include "radiosity/output_file.h"
 
 namespace mbr {
 namespace {
@@ -275,34 +276,29 @@ Image compose(const Measured& M, const ReceiverOptions& options) {
 
 int run(Args& args) {
     const std::string dir = args.text("-o", "");
-    const int n = args.integer("--grid", 256);
+    const int n = args.integer("--grid", 256, 16, 1024);
     const double error_max = args.number("--error-max", 0);
     ReceiverOptions options = read_receiver_options(args);
     args.finish();
     if (dir.empty()) throw UsageError("-o DIR is required");
-    if (n < 16 || n > 1024) throw UsageError("--grid must be in 16..1024");
     if (args.has("--error-max") && !(error_max >= 1e-9 && error_max <= 10))
         throw UsageError("--error-max must be in 1e-9..10");
-    if (!std::filesystem::exists(dir))
-        throw InputError(dir, 0, "the output directory does not exist");
-    if (!std::filesystem::is_directory(dir)) throw InputError(dir, 0, "is not a directory");
+    const std::filesystem::path base(dir);
+    const std::string path_a = (base / "figure7a_parallel.png").string();
+    const std::string path_b = (base / "figure7b_perpendicular.png").string();
+    std::error_code ec;
+    if (std::filesystem::exists(base, ec) && !std::filesystem::is_directory(base, ec))
+        throw OutputError(dir, "is not a folder (-o names the folder the two images go to)");
+    check_output_path(path_a);  // a missing or read-only folder fails now, not after the work
+    check_output_path(path_b);
 
     const Measured a = measure("(a)", "parallel unit squares, h = 0.5", parallel_squares(0.5), 4,
                                options, n, error_max);
     const Measured b = measure("(b)", "perpendicular unit squares, shared edge t = 0",
                                perpendicular_squares(), 3, options, n, error_max);
-    // Both images exist in memory before either file is written.
-    const Image image_a = compose(a, options), image_b = compose(b, options);
-    const std::filesystem::path base(dir);
-    const std::string path_a = (base / "figure7a_parallel.png").string();
-    const std::string path_b = (base / "figure7b_perpendicular.png").string();
-    write_png(path_a, image_a);
-    try {
-        write_png(path_b, image_b);
-    } catch (...) {
-        std::remove(path_a.c_str());  // both figures or neither
-        throw;
-    }
+    // Both images exist in memory before either file is written; both or neither replaced.
+    write_files(
+        {{path_a, encode_png(compose(a, options))}, {path_b, encode_png(compose(b, options))}});
 
     std::cout << "Figure 7: relative error of a single transfer, " << describe(options) << "\n"
               << "grid " << n << " x " << n << " of cell centres\n\n";

@@ -24,6 +24,7 @@
 //         On the other examples (2 to 17 polygons) the octree gains nothing: the loop over all
 //         polygons is 2-3 times faster.
 #include <algorithm>
+#include <climits>
 #include <cmath>
 #include <iostream>
 #include <optional>
@@ -45,12 +46,12 @@ const char* usage =
     "  Builds the paper's octree over the scene's polygons and times N random closest-hit rays\n"
     "  and N shadow-ray segments through it and through a loop over all polygons.\n"
     "  SCENE             a scene file (or an .obj file, imported)\n"
-    "  --rays N          rays per query kind (default 100000)\n"
-    "  --seed S          seed of the random rays (default 1)\n"
-    "  --max-depth D     deepest octree node, the root at 0 (default 10)\n"
-    "  --leaf-polygons P a node listing more polygons is split (default 8)\n"
-    "  --tessellation T  facets per parameter direction of curved surfaces (default: the "
-    "scene's)\n"
+    "  --rays N          rays per query kind, 1..10000000 (default 100000)\n"
+    "  --seed S          seed of the random rays, 0..2147483647 (default 1)\n"
+    "  --max-depth D     deepest octree node, the root at 0; 0..24 (default 10)\n"
+    "  --leaf-polygons P a node listing more polygons is split; 1..1000000 (default 8)\n"
+    "  --tessellation T  facets per parameter direction of curved surfaces, 1..1024\n"
+    "                    (default: the scene's)\n"
     "  --csv             one row per query kind, with the build numbers on every row\n";
 
 using mbr::Vec3;
@@ -222,23 +223,18 @@ bool ends_with(const std::string& s, const std::string& suffix) {
 
 int run(mbr::Args& args) {
     const bool csv = args.flag("--csv");
-    const int n_rays = args.integer("--rays", 100000);
-    const int seed = args.integer("--seed", 1);
+    // 10^7 rays: two ray arrays of 0.6 GB each, and hours of brute force on a large scene.
+    const int n_rays = args.integer("--rays", 100000, 1, 10000000);
+    const int seed = args.integer("--seed", 1, 0, INT_MAX);
     mbr::OctreeOptions options;
-    options.max_depth = args.integer("--max-depth", options.max_depth);
-    options.max_polygons_per_leaf = args.integer("--leaf-polygons", options.max_polygons_per_leaf);
+    options.max_depth = args.integer("--max-depth", options.max_depth, 0, 24);
+    options.max_polygons_per_leaf =
+        args.integer("--leaf-polygons", options.max_polygons_per_leaf, 1, 1000000);
     const bool has_tessellation = args.has("--tessellation");
-    const int tessellation_option = args.integer("--tessellation", 16);
+    const int tessellation_option = args.integer("--tessellation", 16, 1, 1024);
     std::vector<std::string> files = args.positional();
     args.finish();
     if (files.size() != 1) throw mbr::UsageError("expected one SCENE file");
-    if (n_rays < 1) throw mbr::UsageError("--rays must be at least 1");
-    if (options.max_depth < 0 || options.max_depth > 24)
-        throw mbr::UsageError("--max-depth must be in 0..24");
-    if (options.max_polygons_per_leaf < 1)
-        throw mbr::UsageError("--leaf-polygons must be at least 1");
-    if (has_tessellation && (tessellation_option < 1 || tessellation_option > 1024))
-        throw mbr::UsageError("--tessellation must be in 1..1024");
 
     const std::string& path = files[0];
     mbr::Scene scene = ends_with(path, ".obj") ? mbr::load_obj(path) : mbr::load_scene(path);

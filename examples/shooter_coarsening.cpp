@@ -25,19 +25,18 @@ namespace {
 const char* usage =
     "usage: shooter_coarsening [--depth d] [--order m] [--csv]\n"
     "  The cost and the accuracy of coarsening the shooter's unshot field (section 6).\n"
-    "  --depth d   depth of the first bounce's receiver, the shooter of the second (default 4)\n"
-    "  --order m   B-spline order (default 4)\n"
+    "  --depth d   depth of the first bounce's receiver, the shooter of the second, 1..7\n"
+    "              (default 4)\n"
+    "  --order m   B-spline order, 2..8 (default 4)\n"
     "  --csv       header levels_removed,shooter_level,mean_rel_percent,max_rel_percent,\n"
     "              power_change_percent,kernel_evals,seconds\n";
 
 int run(mbr::Args& args) {
     using namespace mbr;
-    const int depth = args.integer("--depth", 4);
-    const int m = args.integer("--order", 4);
+    const int depth = args.integer("--depth", 4, 1, 7);
+    const int m = args.integer("--order", 4, 2, 8);
     const bool csv = args.flag("--csv");
     args.finish();
-    if (depth < 1 || depth > 7) throw UsageError("--depth must be between 1 and 7");
-    if (m < 2 || m > 8) throw UsageError("--order must be between 2 and 8");
 
     const Surface light = Surface::planar_quad({0.1, 0.1, 0.3}, {0.1, 0.4, 0.3}, {0.4, 0.4, 0.3},
                                                {0.4, 0.1, 0.3});

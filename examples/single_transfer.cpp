@@ -27,11 +27,11 @@ std::string usage() {
                "                            (1,1) (0,1) (default: the unit square at z = 1,\n"
                "                            facing down)\n"
                "  --receiver ...            the same (default: the unit square at z = 0, facing up)\n"
-               "  --depth d                 uniform receiver depth (default 3)\n"
+               "  --depth d                 uniform receiver depth, 0..12 (default 3)\n"
                "  --adaptive                oracle subdivision instead (section 6)\n"
                "  --oracle-tolerance T      oracle threshold (default 1e-3)\n"
-               "  --min-depth a --max-depth b   bounds of the adaptive tree (default 1, 6)\n"
-               "  --grid N                  error grid (default 256)\n"
+               "  --min-depth a --max-depth b   bounds of the adaptive tree, 0..12 (default 1, 6)\n"
+               "  --grid N                  error grid, 2..4096 (default 256)\n"
                "  --csv                     header rea_percent,max_rel_percent,leaves,coefficients,\n"
                "                            kernel_evals,seconds\n") +
            mbr::receiver_options_usage;
@@ -52,24 +52,11 @@ int run(mbr::Args& args) {
     const TransferSetup defaults = parallel_squares(1.0);
     TransferSetup setup{read_quad(args, "--shooter", defaults.shooter),
                         read_quad(args, "--receiver", defaults.receiver)};
-    ReceiverOptions options = read_receiver_options(args);
-    const bool adaptive = args.flag("--adaptive");
-    const int depth = args.integer("--depth", 3);
-    options.oracle_tolerance = args.number("--oracle-tolerance", options.oracle_tolerance);
-    options.min_depth = args.integer("--min-depth", options.min_depth);
-    options.max_depth = args.integer("--max-depth", options.max_depth);
-    const int grid = args.integer("--grid", 256);
+    const bool adaptive = args.has("--adaptive");
+    const ReceiverOptions options = read_tree_options(args, read_receiver_options(args));
+    const int grid = args.integer("--grid", 256, 2, 4096);
     const bool csv = args.flag("--csv");
     args.finish();
-    if (!adaptive) {
-        if (args.has("--min-depth") || args.has("--max-depth") || args.has("--oracle-tolerance"))
-            throw UsageError("--min-depth, --max-depth and --oracle-tolerance need --adaptive");
-        options.min_depth = options.max_depth = depth;
-    }
-    if (options.min_depth < 0 || options.max_depth > 12 || options.min_depth > options.max_depth)
-        throw UsageError("depths must satisfy 0 <= min <= max <= 12");
-    if (!(options.oracle_tolerance > 0)) throw UsageError("--oracle-tolerance must be positive");
-    if (grid < 2 || grid > 4096) throw UsageError("--grid must be between 2 and 4096");
     // The two fronts must face each other somewhere, or nothing is transferred.
     const SurfacePoint centre = setup.receiver.evaluate(0.5, 0.5);
     const SurfacePoint source = setup.shooter.evaluate(0.5, 0.5);
@@ -92,7 +79,7 @@ int run(mbr::Args& args) {
               << (adaptive ? "  adaptive receiver tree, oracle tolerance " + cell_g(options.oracle_tolerance, 3) +
                                  ", depths " + std::to_string(options.min_depth) + ".." +
                                  std::to_string(options.max_depth)
-                           : "  uniform receiver depth " + std::to_string(depth))
+                           : "  uniform receiver depth " + std::to_string(options.max_depth))
               << "\n\n";
     table.write_text(std::cout);
     std::cout << "\n  unified level j = " << s.level << " (" << run.n_coefficients

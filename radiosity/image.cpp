@@ -1,20 +1,19 @@
-// radiosity/image.cpp - PNG output with stb_image_write (Debian libstb-dev).
+// radiosity/image.cpp - PNG output with stb_image_write (Debian libstb-dev), encoded in memory:
+// stb's file writer does not check fwrite or fclose, so it is never given a file.
 #include "radiosity/image.h"
 
 #include <stb_image_write.h>
-#include <unistd.h>
 
 #include <algorithm>
-#include <cerrno>
 #include <cmath>
-#include <cstdio>
-#include <cstring>
+#include <stdexcept>
 
 #include "math/check.h"
+#include "radiosity/output_file.h"
 
 namespace mbr {
 
-void write_png(const std::string& path, const Image& image) {
+std::string encode_png(const Image& image) {
     MBR_CHECK(image.width > 0 && image.height > 0 &&
               image.pixels.size() == size_t(image.width) * image.height);
     std::vector<unsigned char> bytes(size_t(image.width) * image.height * 3);
@@ -24,17 +23,21 @@ void write_png(const std::string& path, const Image& image) {
             v = std::isfinite(v) ? std::clamp(v, 0.0, 1.0) : 0.0;
             bytes[3 * i + c] = static_cast<unsigned char>(std::lround(255 * v));
         }
-    // Same folder as the target, so the rename cannot cross file systems.
-    const std::string tmp = path + ".tmp-" + std::to_string(static_cast<long>(getpid()));
-    if (!stbi_write_png(tmp.c_str(), image.width, image.height, 3, bytes.data(), image.width * 3)) {
-        std::remove(tmp.c_str());
-        throw InputError(path, 0, "cannot write the PNG file (does its folder exist?)");
-    }
-    if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-        int err = errno;
-        std::remove(tmp.c_str());
-        throw InputError(path, 0, std::string("cannot write the PNG file: ") + std::strerror(err));
-    }
+    std::string png;
+    auto append = [](void* context, void* data, int size) {
+        static_cast<std::string*>(context)->append(static_cast<const char*>(data), size_t(size));
+    };
+    // stb reports failure only when its own allocation of the compressed data fails.
+    if (!stbi_write_png_to_func(append, &png, image.width, image.height, 3, bytes.data(),
+                                image.width * 3))
+        throw std::runtime_error("stb_image_write could not encode a " +
+                                 std::to_string(image.width) + " x " +
+                                 std::to_string(image.height) + " PNG");
+    return png;
+}
+
+void write_png(const std::string& path, const Image& image) {
+    write_file(path, encode_png(image));
 }
 
 }  // namespace mbr

@@ -1,12 +1,13 @@
-// radiosity/image.h - an RGB image and PNG output through stb_image_write. Files are written
-// to a temporary name in the same folder and renamed, so a failed run never leaves a partial
-// image behind.
+// radiosity/image.h - an RGB image and PNG output through stb_image_write. The PNG is encoded
+// in memory and written by write_file (radiosity/output_file.h): all or nothing, every write
+// checked, so a full disk or a missing folder never leaves a partial image behind.
 #pragma once
 
 #include <string>
 #include <vector>
 
 #include "math/vec3.h"
+#include "radiosity/output_file.h"
 
 namespace mbr {
 
@@ -22,8 +23,11 @@ struct Image {
     const Rgb& at(int x, int y) const { return pixels[size_t(y) * width + x]; }
 };
 
-/// Writes an 8-bit PNG (values clamped to [0, 1], rounded). Throws InputError naming the path
-/// when the file cannot be written; the target is replaced only on success.
+/// The bytes of an 8-bit RGB PNG of the image (values clamped to [0, 1], rounded; NaN as 0).
+std::string encode_png(const Image& image);
+
+/// Writes encode_png(image) to path with write_file: the target is replaced only on success.
+/// Throws OutputError naming the path and the system's reason when it cannot be written.
 void write_png(const std::string& path, const Image& image);
 
 }  // namespace mbr

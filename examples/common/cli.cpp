@@ -1,14 +1,22 @@
 // examples/common/cli.cpp - command-line parsing, tables and the main() wrapper.
 #include "examples/common/cli.h"
 
+#include <unistd.h>
+
 #include <algorithm>
+#include <array>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <iostream>
+#include <new>
+#include <streambuf>
 
 #include "math/check.h"
+#include "radiosity/output_file.h"
 
 namespace mbr {
 
@@ -27,6 +35,10 @@ Args::Args(int argc, char** argv, std::string usage) : usage_(std::move(usage)) 
         }
     }
     used_.assign(tokens_.size(), false);
+    // DESIGN: a help request wins over everything else on the line, in any position, so that
+    // "--bogus --help" prints the usage as "--help --bogus" does; its tokens count as read.
+    for (size_t i = 0; i < tokens_.size(); ++i)
+        if (tokens_[i] == "--help" || tokens_[i] == "-h") help_ = used_[i] = true;
 }
 
 int Args::find(const std::string& name) const {
@@ -75,14 +87,21 @@ double Args::number(const std::string& name, double def) {
     return i < 0 ? def : parse_number(take_value(name, i), name);
 }
 
-int Args::integer(const std::string& name, int def) {
+int Args::integer(const std::string& name, int def, int min, int max) {
+    MBR_CHECK(min <= max);
     int i = find(name);
     if (i < 0) return def;
-    std::string v = take_value(name, i);
-    char* end = nullptr;
-    long x = std::strtol(v.c_str(), &end, 10);
-    if (v.empty() || end != v.c_str() + v.size() || x < -1000000000L || x > 1000000000L)
-        throw UsageError(name + " expects an integer, got '" + v + "'");
+    const std::string v = take_value(name, i);
+    // Digits with an optional sign and nothing else (strtoll alone would skip leading blanks).
+    const size_t first = !v.empty() && (v[0] == '-' || v[0] == '+') ? 1 : 0;
+    bool digits = v.size() > first;
+    for (size_t k = first; k < v.size(); ++k) digits = digits && v[k] >= '0' && v[k] <= '9';
+    if (!digits) throw UsageError(name + " expects an integer, got '" + v + "'");
+    errno = 0;
+    const long long x = std::strtoll(v.c_str(), nullptr, 10);
+    if (errno == ERANGE || x < min || x > max)
+        throw UsageError(name + " must be in " + std::to_string(min) + ".." + std::to_string(max) +
+                         ", got " + v);
     return static_cast<int>(x);
 }
 
@@ -114,10 +133,6 @@ std::vector<std::string> Args::positional() {
 void Args::finish() {
     for (size_t i = 0; i < tokens_.size(); ++i)
         if (!used_[i]) {
-            if (tokens_[i] == "--help" || tokens_[i] == "-h") {
-                std::cout << usage_;
-                std::exit(0);
-            }
             if (tokens_[i].rfind("-", 0) == 0) throw UsageError("unknown option " + tokens_[i]);
             throw UsageError("unexpected argument '" + tokens_[i] + "'");
         }
@@ -168,21 +183,103 @@ std::string cell_g(double value, int digits) {
     return buf;
 }
 
+namespace {
+
+// std::cout's buffer while run_main runs a program. It writes file descriptor 1 itself and
+// keeps the first error, because stdio's buffer forgets errno once it drops a failed block: a
+// report or CSV cut off by a full disk must end in status 1 with the reason, not status 0.
+// Line-buffered on a terminal, so that progress lines show as they are printed.
+class CheckedStdout : public std::streambuf {
+public:
+    CheckedStdout() : line_buffered_(::isatty(STDOUT_FILENO) == 1) { reset(); }
+    /// The errno of the first failed write, 0 if none failed.
+    int error() const { return error_; }
+
+protected:
+    int_type overflow(int_type c) override {
+        if (!drain()) return traits_type::eof();
+        if (!traits_type::eq_int_type(c, traits_type::eof())) {
+            *pptr() = traits_type::to_char_type(c);
+            pbump(1);
+        }
+        return traits_type::not_eof(c);
+    }
+    std::streamsize xsputn(const char* s, std::streamsize n) override {
+        const std::streamsize done = std::streambuf::xsputn(s, n);
+        if (line_buffered_ && std::memchr(s, '\n', size_t(done)) && !drain()) return 0;
+        return done;
+    }
+    int sync() override { return drain() ? 0 : -1; }
+
+private:
+    void reset() { setp(buffer_.data(), buffer_.data() + buffer_.size()); }
+    // Writes out the buffer; false (and the buffer dropped) once any write has failed.
+    bool drain() {
+        const char* p = pbase();
+        size_t left = size_t(pptr() - pbase());
+        reset();
+        while (error_ == 0 && left > 0) {
+            const ssize_t n = ::write(STDOUT_FILENO, p, left);
+            if (n < 0 && errno != EINTR) error_ = errno;
+            if (n > 0) p += n, left -= size_t(n);
+        }
+        return error_ == 0;
+    }
+    std::array<char, 1 << 16> buffer_;
+    bool line_buffered_ = false;
+    int error_ = 0;
+};
+
+// Runs body and turns its exceptions into one stderr line and a status.
+int run_body(Args& args, const std::function<int(Args&)>& body) {
+    const std::string& program = args.program();
+    try {
+        if (args.help_requested()) {
+            std::cout << args.usage();
+            return 0;
+        }
+        return body(args);
+    } catch (const UsageError& e) {
+        std::cerr << program << ": " << e.what() << " (" << program
+                  << " --help lists the options)\n";
+        return 2;
+    } catch (const InputError& e) {
+        std::cerr << program << ": " << e.what() << "\n";
+        return 2;
+    } catch (const OutputError& e) {
+        std::cerr << program << ": " << e.what() << "\n";
+        return 1;
+    } catch (const std::bad_alloc&) {
+        std::cerr << program << ": error: out of memory\n";
+        return 1;
+    } catch (const std::exception& e) {
+        std::cerr << program << ": error: " << e.what() << "\n";
+        return 1;
+    } catch (...) {
+        std::cerr << program << ": error: an unknown exception\n";
+        return 1;
+    }
+}
+
+}  // namespace
+
 int run_main(int argc, char** argv, const std::string& usage,
              const std::function<int(Args&)>& body) {
     Args args(argc, argv, usage);
-    try {
-        return body(args);
-    } catch (const UsageError& e) {
-        std::cerr << args.program() << ": " << e.what() << "\n" << usage;
-        return 2;
-    } catch (const InputError& e) {
-        std::cerr << args.program() << ": " << e.what() << "\n";
-        return 2;
-    } catch (const std::exception& e) {
-        std::cerr << args.program() << ": error: " << e.what() << "\n";
-        return 1;
+    // Whatever was printed before goes out first, through the old buffer.
+    std::cout.flush();
+    std::fflush(stdout);
+    CheckedStdout out;
+    std::streambuf* const previous = std::cout.rdbuf(&out);
+    int status = run_body(args, body);
+    std::cout.flush();
+    std::cout.rdbuf(previous);  // also clears a bad state left by a failed write
+    if (out.error() != 0) {
+        std::cerr << args.program()
+                  << ": standard output: cannot write: " << std::strerror(out.error()) << "\n";
+        if (status == 0) status = 1;
     }
+    return status;
 }
 
 double now_seconds() {

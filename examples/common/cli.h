@@ -1,8 +1,12 @@
 // examples/common/cli.h - what every mbr program shares: a small command-line parser that
 // rejects what it does not understand, a table that prints as aligned text or CSV, and the
-// main() wrapper that turns exceptions into one stderr line and an exit code (STYLE.md B7).
+// main() wrapper that turns exceptions into one stderr line and an exit code (STYLE.md B7):
+// 0 on success, 2 for a bad command line or bad input (UsageError, InputError), 1 for a failure
+// while running (OutputError from radiosity/output_file.h and anything else), including a
+// failure to write the report or CSV on stdout.
 #pragma once
 
+#include <climits>
 #include <functional>
 #include <iosfwd>
 #include <stdexcept>
@@ -11,14 +15,17 @@
 
 namespace mbr {
 
-/// A bad command line; main prints the message and the usage text and exits with 2.
+/// A bad command line; run_main prints the message on one line and exits with 2.
 class UsageError : public std::runtime_error {
 public:
     using std::runtime_error::runtime_error;
 };
 
 /// Options are read by asking for them; finish() then rejects anything left unread.
-/// "--name value", "--name=value" and flags "--name" are understood.
+/// "--name value", "--name=value" and flags "--name" are understood. "--help" or "-h" anywhere
+/// on the line asks for the usage text, whatever else the line holds (run_main prints it and
+/// exits 0 before the program reads a single option, so "--bogus --help" and "--help --bogus"
+/// behave alike).
 class Args {
 public:
     Args(int argc, char** argv, std::string usage);
@@ -30,15 +37,19 @@ public:
     std::string text(const std::string& name, const std::string& def);
     /// A finite number; UsageError on anything else.
     double number(const std::string& name, double def);
-    /// An integer; UsageError on anything else.
-    int integer(const std::string& name, int def);
+    /// An integer in min..max (def when absent, which need not be in the range). UsageError
+    /// "NAME expects an integer" on anything but digits with an optional sign, and "NAME must be
+    /// in MIN..MAX" on an integer outside, however large. Give each option its own range.
+    int integer(const std::string& name, int def, int min = INT_MIN, int max = INT_MAX);
     /// "--name x1 x2 ... xn": exactly n numbers, or an empty vector when absent.
     std::vector<double> numbers(const std::string& name, int n);
     /// True when "--name" was given at all (with or without a value).
     bool has(const std::string& name) const;
+    /// True when "--help" or "-h" is on the line (anywhere).
+    bool help_requested() const { return help_; }
     /// The positional arguments (call after reading every option).
     std::vector<std::string> positional();
-    /// Throws UsageError naming the first option nobody asked for; prints usage on --help.
+    /// Throws UsageError naming the first option nobody asked for.
     void finish();
 
 private:
@@ -47,6 +58,7 @@ private:
     std::string program_, usage_;
     std::vector<std::string> tokens_;
     std::vector<bool> used_;
+    bool help_ = false;
 };
 
 /// Parses a whole string as a finite double; UsageError naming `what` otherwise.
@@ -73,7 +85,11 @@ std::string cell(double value, int digits);
 std::string cell_g(double value, int digits);
 
 /// Runs body(args) and maps exceptions to exit codes: 2 for UsageError and InputError (bad
-/// input), 1 for any other failure. Writes one line to stderr, never a partial result.
+/// input), 1 for OutputError and any other failure, each with one line on stderr. With --help
+/// on the line it prints the usage on stdout and returns 0 without running body. While body
+/// runs, std::cout writes file descriptor 1 through a buffer that keeps the first write error:
+/// if the report cannot be written completely (a full disk, a closed pipe) the status is 1 and
+/// stderr says why, never 0 over a cut-off output.
 int run_main(int argc, char** argv, const std::string& usage,
              const std::function<int(Args&)>& body);
 

@@ -6,11 +6,11 @@
 namespace mbr {
 
 const char* receiver_options_usage =
-    "  --order m                 B-spline order (default 4)\n"
+    "  --order m                 B-spline order, 2..8 (default 4)\n"
     "  --extrapolation K         linear (23)-(25) (default), higher = quadratic (26), cubic (27)\n"
     "  --rhombus-radius R        truncation radius in cells of each fulcrum's scale\n"
     "  --eps E                   relative truncation |DN x DN| > E (default 1e-7, about 26\n"
-    "                            cells for m = 4); --rhombus-radius wins when both are given\n"
+    "                            cells for m = 4); not together with --rhombus-radius\n"
     "  --quadrature-tolerance T  relative tolerance of the adaptive rule of (21) (default 1e-4)\n"
     "  --unify paper|projection  stage 8: refine coarse coefficients by (17) (the paper's rule,\n"
     "                            default) or project every finest-scale coefficient\n"
@@ -18,17 +18,19 @@ const char* receiver_options_usage =
     "  --edgefill chord|paper    edgefill's test: the midpoint against the chord (default),\n"
     "                            or the paper's |dB(s3) - dB(s1)| small\n"
     "  --clamp C                 derivative clamp of the linear extrapolation (default 1)\n"
-    "  --coarsen-shooter L       levels the shooter's unshot field is coarsened (default 1)\n";
+    "  --coarsen-shooter L       levels the shooter's unshot field is coarsened, 0..14\n"
+    "                            (default 1)\n";
 
 ReceiverOptions read_receiver_options(Args& args) {
     ReceiverOptions o;
-    o.m = args.integer("--order", o.m);
-    if (o.m < 2 || o.m > 8) throw UsageError("--order must be between 2 and 8");
+    o.m = args.integer("--order", o.m, 2, 8);
     const std::string kind = args.text("--extrapolation", "linear");
     if (kind == "linear") o.extrapolation = Extrapolation::Linear;
     else if (kind == "higher" || kind == "quadratic") o.extrapolation = Extrapolation::Quadratic;
     else if (kind == "cubic") o.extrapolation = Extrapolation::Cubic;
     else throw UsageError("--extrapolation must be linear, higher, quadratic or cubic");
+    if (args.has("--eps") && args.has("--rhombus-radius"))
+        throw UsageError("--eps and --rhombus-radius exclude each other: both set the truncation");
     o.truncation_eps = args.number("--eps", o.truncation_eps);
     if (!(o.truncation_eps > 0 && o.truncation_eps < 1)) throw UsageError("--eps must be in (0, 1)");
     o.rhombus_radius = args.number("--rhombus-radius", 0);
@@ -48,8 +50,28 @@ ReceiverOptions read_receiver_options(Args& args) {
     o.edgefill_test = edgefill == "paper" ? EdgefillTest::Variation : EdgefillTest::Linearity;
     o.clamp_factor = args.number("--clamp", o.clamp_factor);
     if (!(o.clamp_factor > 0)) throw UsageError("--clamp must be positive");
-    o.shooter_coarsening = args.integer("--coarsen-shooter", o.shooter_coarsening);
-    if (o.shooter_coarsening < 0) throw UsageError("--coarsen-shooter must be >= 0");
+    // 14: the deepest receiver tree transfer() accepts, so the finest field there is.
+    o.shooter_coarsening = args.integer("--coarsen-shooter", o.shooter_coarsening, 0, 14);
+    return o;
+}
+
+ReceiverOptions read_tree_options(Args& args, ReceiverOptions o) {
+    const bool adaptive = args.flag("--adaptive");
+    const int depth = args.integer("--depth", 3, 0, 12);
+    o.oracle_tolerance = args.number("--oracle-tolerance", o.oracle_tolerance);
+    o.min_depth = args.integer("--min-depth", o.min_depth, 0, 12);
+    o.max_depth = args.integer("--max-depth", o.max_depth, 0, 12);
+    // Each mode refuses the options of the other rather than ignoring them.
+    if (adaptive && args.has("--depth"))
+        throw UsageError("--depth has no effect with --adaptive: the adaptive tree is bounded by "
+                         "--min-depth and --max-depth");
+    if (!adaptive) {
+        if (args.has("--min-depth") || args.has("--max-depth") || args.has("--oracle-tolerance"))
+            throw UsageError("--min-depth, --max-depth and --oracle-tolerance need --adaptive");
+        o.min_depth = o.max_depth = depth;
+    }
+    if (o.min_depth > o.max_depth) throw UsageError("--min-depth must not exceed --max-depth");
+    if (!(o.oracle_tolerance > 0)) throw UsageError("--oracle-tolerance must be positive");
     return o;
 }
 

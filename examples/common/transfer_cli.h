@@ -18,6 +18,13 @@ extern const char* receiver_options_usage;
 /// --coarsen-shooter into ReceiverOptions (depths are left to the caller).
 ReceiverOptions read_receiver_options(Args& args);
 
+/// The receiver tree of one transfer: "--depth d" (uniform, 0..12, default 3) or "--adaptive"
+/// (the oracle of section 6) with --oracle-tolerance T and --min-depth a --max-depth b (0..12,
+/// default 1 and 6). Each mode refuses the other's options with a UsageError instead of
+/// ignoring them ("--depth has no effect with --adaptive"). Returns base with min_depth,
+/// max_depth and oracle_tolerance set.
+ReceiverOptions read_tree_options(Args& args, ReceiverOptions base);
+
 /// A one-line description of the options that matter for the tables.
 std::string describe(const ReceiverOptions& options);
 
