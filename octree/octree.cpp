@@ -93,28 +93,34 @@ const char* to_string(NodeTestResult result) {
     return "?";
 }
 
-ProjectionRelation projection_relation(const Box3& cube, const Polygon& polygon, int axis) {
-    MBR_CHECK_MSG(axis >= 0 && axis < 3, "axis " << axis);
+namespace {
+
+// projection_relation with the lean tolerance given: classify_node_polygon computes it once for
+// its three projections and its plane test.
+ProjectionRelation projection_relation(const Box3& cube, const Polygon& polygon, int axis,
+                                       double tol) {
     // The plane perpendicular to `axis`, with coordinates (a, b) in right-handed order.
     const int a = (axis + 1) % 3, b = (axis + 2) % 3;
+    // The projected vertices are read in place: this test runs for every polygon of a node
+    // against each of its eight children, and a copy on the heap took a fifth of the build time.
     const std::vector<Vec3>& v3 = polygon.vertices();
     const int n = polygon.n_vertices();
-    std::vector<Vec2> v(n);
-    for (int i = 0; i < n; ++i) v[i] = {v3[i][a], v3[i][b]};
+    auto v = [&](int i) { return Vec2{v3[i][a], v3[i][b]}; };
     const Vec2 lo{cube.lo[a], cube.lo[b]}, hi{cube.hi[a], cube.hi[b]};
 
     // Contained: every vertex in the closed square (exact comparisons). A convex polygon is the
     // hull of its vertices, so the whole projection is inside.
     bool all_inside = true;
-    for (Vec2 p : v)
+    for (int i = 0; i < n && all_inside; ++i) {
+        const Vec2 p = v(i);
         if (p.x < lo.x || p.x > hi.x || p.y < lo.y || p.y > hi.y) all_inside = false;
+    }
     if (all_inside) return ProjectionRelation::inside;
 
     // Intersecting: some edge meets the square (grown by the lean tolerance).
-    const double tol = lean_rel * coordinate_scale(cube, polygon);
     const Vec2 lo_t{lo.x - tol, lo.y - tol}, hi_t{hi.x + tol, hi.y + tol};
     for (int i = 0; i < n; ++i)
-        if (segment_meets_rect(v[i], v[(i + 1) % n], lo_t, hi_t))
+        if (segment_meets_rect(v(i), v((i + 1) % n), lo_t, hi_t))
             return ProjectionRelation::undecided;
 
     // No edge meets the square, so the square is wholly inside the projection (surrounding) or
@@ -122,18 +128,26 @@ ProjectionRelation projection_relation(const Box3& cube, const Polygon& polygon,
     // away from every edge, so the signs below are far above rounding.
     Vec2 c{0.5 * (lo.x + hi.x), 0.5 * (lo.y + hi.y)};
     double area2 = 0;  // twice the signed projected area: its sign is the orientation
-    for (int i = 1; i + 1 < n; ++i) area2 += cross(v[i] - v[0], v[i + 1] - v[0]);
+    for (int i = 1; i + 1 < n; ++i) area2 += cross(v(i) - v(0), v(i + 1) - v(0));
     if (area2 == 0) return ProjectionRelation::apart;  // a segment surrounds nothing
     for (int i = 0; i < n; ++i) {
-        double side = cross(v[(i + 1) % n] - v[i], c - v[i]);
+        double side = cross(v((i + 1) % n) - v(i), c - v(i));
         if (area2 > 0 ? side < 0 : side > 0) return ProjectionRelation::apart;
     }
     return ProjectionRelation::undecided;
 }
 
+}  // namespace
+
+ProjectionRelation projection_relation(const Box3& cube, const Polygon& polygon, int axis) {
+    MBR_CHECK_MSG(axis >= 0 && axis < 3, "axis " << axis);
+    return projection_relation(cube, polygon, axis, lean_rel * coordinate_scale(cube, polygon));
+}
+
 NodeTestResult classify_node_polygon(const Box3& cube, const Polygon& polygon) {
     // Step 1: bounding boxes (closed; exact comparisons).
     if (!overlaps(cube, polygon.bounds())) return NodeTestResult::apart_by_bounds;
+    const double lean = lean_rel * coordinate_scale(cube, polygon);
 
     // Step 2: projections onto xy, yz, zx. "Inside" on any one decides "meet": the polygon is
     // connected and its bounding box overlaps the cube's along the projection axis, so some point
@@ -141,7 +155,7 @@ NodeTestResult classify_node_polygon(const Box3& cube, const Polygon& polygon) {
     // (possible only within the lean tolerance), so that the answer stays conservative.
     bool apart = false;
     for (int axis : {2, 0, 1}) {
-        ProjectionRelation r = projection_relation(cube, polygon, axis);
+        ProjectionRelation r = projection_relation(cube, polygon, axis, lean);
         if (r == ProjectionRelation::inside) return NodeTestResult::meet_by_projection;
         if (r == ProjectionRelation::apart) apart = true;
     }
@@ -150,7 +164,7 @@ NodeTestResult classify_node_polygon(const Box3& cube, const Polygon& polygon) {
     // Step 3: the side of the polygon's plane of each of the eight corners. "Strictly one side"
     // must beat the lean tolerance and any non-planarity of the vertices.
     const Plane& plane = polygon.plane();
-    const double tol = lean_rel * coordinate_scale(cube, polygon) + polygon.planarity_error();
+    const double tol = lean + polygon.planarity_error();
     bool any_above = false, any_below = false;
     for (int i = 0; i < 8; ++i) {
         Vec3 corner{(i & 1) ? cube.hi.x : cube.lo.x, (i & 2) ? cube.hi.y : cube.lo.y,

@@ -13,6 +13,8 @@
 #include <map>
 #include <set>
 #include <sstream>
+#include <unordered_map>
+#include <unordered_set>
 
 #include "math/check.h"
 
@@ -53,12 +55,31 @@ std::string in_quotes(const std::string& s) {
     return out + "'";
 }
 
-/// Shortest text that reads back as x, for messages.
+/// x for messages about numbers the user wrote, and about limits: the shortest text that reads
+/// back as exactly x, so that a value just beyond a limit never prints as the limit itself
+/// ("100000000.1 exceeds the limit 100000000"). Positional notation for magnitudes in
+/// [1e-5, 1e16), where it is exact and readable; scientific notation outside.
 std::string fmt(double x) {
+    char buf[64];
+    const double a = std::fabs(x);
+    const bool positional = a == 0 || (a >= 1e-5 && a < 1e16);
+    auto r = positional ? std::to_chars(buf, buf + sizeof buf, x, std::chars_format::fixed)
+                        : std::to_chars(buf, buf + sizeof buf, x);
+    return r.ec == std::errc() ? std::string(buf, r.ptr) : std::string("?");
+}
+
+/// x for messages about derived quantities (a deviation, a percentage, an area), which the user
+/// did not write and which need no more than six significant digits.
+std::string fmt_approx(double x) {
     std::ostringstream os;
     os.precision(6);
     os << x;
     return os.str();
+}
+
+/// "1 word", "3 words": a count with its noun in the right number.
+std::string counted(long n, const std::string& singular, const std::string& plural) {
+    return std::to_string(n) + " " + (n == 1 ? singular : plural);
 }
 
 /// One statement: its file, line number and tokens.
@@ -217,14 +238,40 @@ std::string canonical_name(const std::string& path) {
     return p.string();
 }
 
-/// Counts files opened below one top-level load, to bound exponential include trees.
-struct FileBudget {
-    int n_files = 0;
+/// What the readers of one top-level load share: the count of files opened, which bounds
+/// exponential include trees, and the texture images decoded so far.
+class LoadState {
+public:
+    /// Counts one more file read on behalf of `line`.
     void charge(const Line& line) {
-        if (++n_files > max_files_read)
+        if (++n_files_ > max_files_read)
             line.fail("more than " + std::to_string(max_files_read) +
                       " files are read by this scene (includes, OBJ, MTL, textures)");
     }
+
+    /// The image file at `path` (resolved), unscaled. Each file is read and decoded once per
+    /// load, however many materials name it (a big image costs its memory once, not once per
+    /// material); later requests share its texels and are not charged as files read.
+    Texture image(const Line& line, const std::string& path) {
+        const std::string key = canonical_name(path);
+        auto cached = textures_.find(key);
+        if (cached != textures_.end()) return cached->second;
+        charge(line);
+        std::string problem = file_problem(path);
+        if (!problem.empty()) line.fail("texture " + in_quotes(path) + ": " + problem);
+        Texture texture;
+        try {
+            texture = Texture::image(path);
+        } catch (const InputError& e) {
+            line.fail("texture " + in_quotes(path) + ": " + e.message());
+        }
+        textures_.emplace(key, texture);
+        return texture;
+    }
+
+private:
+    int n_files_ = 0;
+    std::unordered_map<std::string, Texture> textures_;  // canonical path -> decoded image
 };
 
 /// Opens a file named on `line`; the message names the line and the path.
@@ -379,11 +426,22 @@ Vec3 vec_at(const std::vector<double>& x, size_t i) {
 // === Quads
 
 std::string planar_quad_problem(const std::array<Vec3, 4>& corners) {
-    std::vector<Vec3> p(corners.begin(), corners.end());
-    for (const Vec3& q : p)
+    for (const Vec3& q : corners)
         if (!is_finite(q)) return "a corner is not finite";
-    double size = max_pairwise_distance(p);
-    if (!(size > 0) || !std::isfinite(size)) return "degenerate quad: all corners coincide";
+    // Every test below works on the corners relative to corner 0 and divided by the largest
+    // coordinate difference, so that its numbers are of order 1 wherever the quad lies and
+    // however large or small it is. In absolute coordinates a quad near 1e8 loses its area to
+    // cancellation in Newell's sum (cross products of 1e8-sized position vectors) and its squared
+    // sizes can overflow. Subtracting corner 0 is exact for corners within a factor 2 of each
+    // other (Sterbenz), which covers a small quad far from the origin.
+    double scale = 0;
+    for (const Vec3& q : corners)
+        for (int k = 0; k < 3; ++k) scale = std::max(scale, std::fabs(q[k] - corners[0][k]));
+    if (!std::isfinite(scale)) return "corners are too far apart to compute with";
+    if (!(scale > 0)) return "degenerate quad: all corners coincide";
+    std::vector<Vec3> p;
+    for (const Vec3& q : corners) p.push_back((q - corners[0]) / scale);
+    const double size = max_pairwise_distance(p);  // in units of scale: in [1, 2 sqrt(3)]
     for (int i = 0; i < 4; ++i)
         for (int j = i + 1; j < 4; ++j)
             if (length(p[i] - p[j]) <= 1e-9 * size)
@@ -400,9 +458,9 @@ std::string planar_quad_problem(const std::array<Vec3, 4>& corners) {
     n = normalize(n);
     double dev = plane_deviation(p, n);
     if (dev > planarity_tolerance * size)
-        return "quad is not planar: a corner lies " + fmt(dev) + " off the corners' mean plane, " +
-               fmt(100 * dev / size) + "% of its size (the limit is " +
-               fmt(100 * planarity_tolerance) + "%)";
+        return "quad is not planar: a corner lies " + fmt_approx(dev * scale) +
+               " off the corners' mean plane, " + fmt_approx(100 * dev / size) +
+               "% of its size (the limit is " + fmt_approx(100 * planarity_tolerance) + "%)";
     for (size_t i = 0; i < 4; ++i)
         if (turn_sine(p, i, n) <= 1e-9)
             return "quad is not convex at corner " + std::to_string(i + 1) +
@@ -497,10 +555,8 @@ bool triangulate(std::vector<Vec3> p, Vec3 n, std::vector<std::array<Vec3, 3>>& 
     return true;
 }
 
-/// The quads of one OBJ face (docs/scene-format.md, "OBJ import"): a valid planar quad stays
-/// one quad; a planar convex polygon of n != 4 corners becomes n quads around its vertex
-/// average; anything else is triangulated (ear clipping) and each triangle becomes three quads.
-std::vector<Quad> face_to_quads(const Line& line, std::vector<Vec3> p) {
+/// face_to_quads for a face given relative to one of its vertices.
+std::vector<Quad> local_face_to_quads(const Line& line, std::vector<Vec3> p) {
     double size = max_pairwise_distance(p);
     if (!(size > 0)) line.fail("degenerate face: all its vertices coincide");
     // Drop repeated vertices, then corners that do not turn (straight or folded back).
@@ -574,6 +630,22 @@ std::vector<Quad> face_to_quads(const Line& line, std::vector<Vec3> p) {
     return quads;
 }
 
+/// The quads of one OBJ face (docs/scene-format.md, "OBJ import"): a valid planar quad stays
+/// one quad; a planar convex polygon of n != 4 corners becomes n quads around its vertex
+/// average; anything else is triangulated (ear clipping) and each triangle becomes three quads.
+std::vector<Quad> face_to_quads(const Line& line, std::vector<Vec3> p) {
+    // The work is done relative to vertex 0, as in planar_quad_problem: Newell's sum and the
+    // turn tests of a small face far from the origin would otherwise drown in cancellation. For
+    // a face small against its distance from the origin the subtraction and the addition back
+    // are both exact, so its vertices come back unchanged.
+    const Vec3 origin = p[0];
+    for (Vec3& x : p) x = x - origin;
+    std::vector<Quad> quads = local_face_to_quads(line, std::move(p));
+    for (Quad& q : quads)
+        for (Vec3& x : q) x = x + origin;
+    return quads;
+}
+
 // ---------------------------------------------------------------------------------------------
 // === OBJ and MTL
 
@@ -589,7 +661,7 @@ struct MtlEntry {
 
 class ObjReader {
 public:
-    ObjReader(std::string name, FileBudget& budget) : name_(std::move(name)), budget_(budget) {
+    ObjReader(std::string name, LoadState& state) : name_(std::move(name)), state_(state) {
         group_ = fs::path(name_).stem().string();
         if (group_.empty()) group_ = "obj";
     }
@@ -664,13 +736,13 @@ private:
 
     /// One index of a face vertex: 1-based, or negative counting back from the last defined.
     long long index(const Line& line, const std::string& text, long long count,
-                    const std::string& what) {
+                    const std::string& what, const std::string& what_plural) {
         long long i = parse_integer(line, text, what + " index", -(1LL << 40), 1LL << 40);
         if (i == 0) line.fail(what + " index 0 is not allowed (OBJ indices start at 1)");
         long long k = i > 0 ? i - 1 : count + i;
         if (k < 0 || k >= count)
             line.fail(what + " index " + std::to_string(i) + " is out of range (" +
-                      std::to_string(count) + " " + what + "s defined so far)");
+                      counted(long(count), what, what_plural) + " defined so far)");
         return k;
     }
 
@@ -695,10 +767,10 @@ private:
                 (parts.size() == 3 && parts[2].empty()))
                 line.fail("malformed face vertex " + in_quotes(ref) +
                           " (expected v, v/vt, v//vn or v/vt/vn)");
-            p.push_back(v_[size_t(index(line, parts[0], long(v_.size()), "vertex"))]);
+            p.push_back(v_[size_t(index(line, parts[0], long(v_.size()), "vertex", "vertices"))]);
             if (parts.size() >= 2 && !parts[1].empty())
-                index(line, parts[1], n_vt_, "texture vertex");
-            if (parts.size() == 3) index(line, parts[2], n_vn_, "normal");
+                index(line, parts[1], n_vt_, "texture vertex", "texture vertices");
+            if (parts.size() == 3) index(line, parts[2], n_vn_, "normal", "normals");
         }
         if (material_ < 0) material_ = default_material();
         for (const Quad& q : face_to_quads(line, p)) {
@@ -720,16 +792,28 @@ private:
         return int(scene_.materials.size()) - 1;
     }
 
-    /// Surfaces of a group with several faces get ".0", ".1", ... in file order.
+    /// A group that yields one surface gives it its own name; the surfaces of a group that
+    /// yields several are NAME.0, NAME.1, ... in file order, skipping every number whose name is
+    /// already taken (by a group of that name, say `a.0` next to a group `a` of two faces), so
+    /// that every name is unique.
     void name_surfaces() {
-        std::map<std::string, int> count, next;
+        std::unordered_map<std::string, int> count, next;
         for (const SceneSurface& s : scene_.surfaces) ++count[s.name];
-        for (SceneSurface& s : scene_.surfaces)
-            if (count[s.name] > 1) s.name += "." + std::to_string(next[s.name]++);
+        std::unordered_set<std::string> taken;
+        for (const auto& [name, n] : count)
+            if (n == 1) taken.insert(name);
+        for (SceneSurface& s : scene_.surfaces) {
+            if (count[s.name] == 1) continue;
+            int& k = next[s.name];
+            std::string numbered;
+            do numbered = s.name + "." + std::to_string(k++);
+            while (!taken.insert(numbered).second);
+            s.name = std::move(numbered);
+        }
     }
 
     void mtllib(const Line& at, const std::string& path) {
-        budget_.charge(at);
+        state_.charge(at);
         std::ifstream in;
         open_named(at, "material library", path, in);
         LineReader reader(in, path);
@@ -812,15 +896,7 @@ private:
     }
 
     Texture mtl_texture(const Line& line, const std::string& file, Rgb scale) {
-        budget_.charge(line);
-        std::string path = resolve(line.file, file);
-        std::string problem = file_problem(path);
-        if (!problem.empty()) line.fail("texture " + in_quotes(path) + ": " + problem);
-        try {
-            return Texture::image(path, scale);
-        } catch (const InputError& e) {
-            line.fail("texture " + in_quotes(path) + ": " + e.message());
-        }
+        return state_.image(line, resolve(line.file, file)).scaled(scale);
     }
 
     void finish_material(const MtlEntry& e, const std::string&) {
@@ -846,11 +922,11 @@ private:
     }
 
     std::string name_;
-    FileBudget& budget_;
+    LoadState& state_;
     Scene scene_;
     std::vector<Vec3> v_;
     long long n_vt_ = 0, n_vn_ = 0;
-    std::map<std::string, int> material_index_;
+    std::unordered_map<std::string, int> material_index_;
     int material_ = -1;
     std::string group_;
 };
@@ -860,7 +936,7 @@ private:
 
 class SceneReader {
 public:
-    explicit SceneReader(FileBudget& budget) : budget_(budget) {}
+    explicit SceneReader(LoadState& state) : state_(state) {}
 
     Scene read(std::istream& in, const std::string& name) {
         read_file(in, name, 0);
@@ -912,11 +988,10 @@ private:
         const std::string& name = line[1];
         if (is_number_token(name))
             line.fail("material name " + in_quotes(name) + " looks like a number");
-        auto seen = material_lines_.find(name);
-        if (seen != material_lines_.end() || scene_.find_material(name) >= 0)
-            line.fail("duplicate material " + in_quotes(name) +
-                      (seen != material_lines_.end() ? " (first defined at " + seen->second + ")"
-                                                     : std::string(" (defined by an OBJ file)")));
+        auto seen = materials_.find(name);
+        if (seen != materials_.end())
+            line.fail("duplicate material " + in_quotes(name) + " (first defined at " +
+                      seen->second.where + ")");
         Material m;
         m.name = name;
         bool has_reflectance = false, has_emission = false;
@@ -936,8 +1011,7 @@ private:
             ++t;
             (refl ? m.reflectance : m.emission) = texture(line, t, refl);
         }
-        material_lines_[name] = line.file + ":" + std::to_string(line.number);
-        scene_.materials.push_back(std::move(m));
+        add_material(std::move(m), line.file + ":" + std::to_string(line.number));
     }
 
     /// Checks a colour against the range of its role.
@@ -984,15 +1058,7 @@ private:
                 ++t;
                 scale = colour(line, t, role + " image scale", reflectance);
             }
-            budget_.charge(line);
-            std::string problem = file_problem(path);
-            if (!problem.empty()) line.fail("texture " + in_quotes(path) + ": " + problem);
-            Texture tex;
-            try {
-                tex = Texture::image(path, scale);
-            } catch (const InputError& e) {
-                line.fail("texture " + in_quotes(path) + ": " + e.message());
-            }
+            Texture tex = state_.image(line, path).scaled(scale);
             check_colour(line, tex.maximum(), reflectance, role + " image maximum");
             return tex;
         }
@@ -1007,12 +1073,13 @@ private:
     void add_surface(const Line& line, const std::string& name, int material, Surface s) {
         double area = s.area();
         if (!(area > 0) || !std::isfinite(area))
-            line.fail("degenerate surface " + in_quotes(name) + ": its area is " + fmt(area));
-        if (surface_lines_.count(name) || scene_.find_surface(name) >= 0)
-            line.fail("duplicate surface name " + in_quotes(name) +
-                      (surface_lines_.count(name) ? " (first used at " + surface_lines_[name] + ")"
-                                                  : std::string()));
-        surface_lines_[name] = line.file + ":" + std::to_string(line.number);
+            line.fail("degenerate surface " + in_quotes(name) + ": its area is " +
+                      fmt_approx(area));
+        auto [seen, is_new] =
+            surface_where_.try_emplace(name, line.file + ":" + std::to_string(line.number));
+        if (!is_new)
+            line.fail("duplicate surface name " + in_quotes(name) + " (first used at " +
+                      seen->second + ")");
         scene_.surfaces.push_back({name, std::move(s), material});
     }
 
@@ -1032,10 +1099,11 @@ private:
         if (line.size() < 3) line.fail(in_quotes(kind) + " needs a name, a material and numbers");
         const std::string& name = line[1];
         const std::string& mat_name = line[2];
-        int material = scene_.find_material(mat_name);
-        if (material < 0)
+        auto found = materials_.find(mat_name);
+        if (found == materials_.end())
             line.fail("unknown material " + in_quotes(mat_name) +
                       " (materials must be defined before the surfaces that use them)");
+        const int material = found->second.index;
         bool inward = false;
         if (kind == "quad" || kind == "bilinear") {
             auto x = read_fields(line, 3, kind, {{"p00", 3}, {"p10", 3}, {"p11", 3}, {"p01", 3}});
@@ -1237,8 +1305,8 @@ private:
 
     void setting(const Line& line) {
         if (line.size() != 3)
-            line.fail("'set' needs a name and one value, found " + std::to_string(line.size() - 1) +
-                      " words");
+            line.fail("'set' needs a name and one value, found " +
+                      counted(long(line.size()) - 1, "word", "words"));
         const std::string& key = line[1];
         const std::string& value = line[2];
         if (!settings_seen_.insert(key).second)
@@ -1298,33 +1366,31 @@ private:
     void obj(const Line& line) {
         if (line.size() != 2) line.fail("'obj' needs one file name");
         std::string path = resolve(line.file, line[1]);
-        budget_.charge(line);
+        state_.charge(line);
         std::ifstream in;
         open_named(line, "OBJ file", path, in);
-        Scene part = ObjReader(path, budget_).read(in);
+        Scene part = ObjReader(path, state_).read(in);
         // Merge: the OBJ's materials join the scene's (names must be new, except the shared
         // default material), then its surfaces with their material indices moved along.
         std::vector<int> index(part.materials.size());
         for (size_t i = 0; i < part.materials.size(); ++i) {
             Material& m = part.materials[i];
-            int existing = scene_.find_material(m.name);
-            if (existing >= 0 && m.name == obj_default_material) {
-                index[i] = existing;
+            auto existing = materials_.find(m.name);
+            if (existing != materials_.end() && m.name == obj_default_material) {
+                index[i] = existing->second.index;
                 continue;
             }
-            if (existing >= 0)
+            if (existing != materials_.end())
                 line.fail("material " + in_quotes(m.name) + " of " + in_quotes(path) +
-                          " is already defined");
-            index[i] = int(scene_.materials.size());
-            material_lines_[m.name] = path;
-            scene_.materials.push_back(std::move(m));
+                          " is already defined (at " + existing->second.where + ")");
+            index[i] = add_material(std::move(m), path);
         }
         for (SceneSurface& s : part.surfaces) {
             s.material = index[size_t(s.material)];
-            if (surface_lines_.count(s.name) || scene_.find_surface(s.name) >= 0)
+            auto [seen, is_new] = surface_where_.try_emplace(s.name, path);
+            if (!is_new)
                 line.fail("surface " + in_quotes(s.name) + " of " + in_quotes(path) +
-                          " has the name of an earlier surface");
-            surface_lines_[s.name] = path;
+                          " has the name of an earlier surface (at " + seen->second + ")");
             scene_.surfaces.push_back(std::move(s));
         }
     }
@@ -1338,16 +1404,32 @@ private:
         std::string canonical = canonical_name(path);
         if (std::find(stack_.begin(), stack_.end(), canonical) != stack_.end())
             line.fail("include cycle: " + in_quotes(path) + " is already being read");
-        budget_.charge(line);
+        state_.charge(line);
         std::ifstream in;
         open_named(line, "included file", path, in);
         read_file(in, path, depth + 1);
     }
 
-    FileBudget& budget_;
+    /// Appends a material to the scene and indexes it; returns its index.
+    int add_material(Material m, const std::string& where) {
+        const int index = int(scene_.materials.size());
+        materials_[m.name] = {index, where};
+        scene_.materials.push_back(std::move(m));
+        return index;
+    }
+
+    /// Where a material was defined ("file:line", or the OBJ file) and its index in the scene.
+    struct MaterialEntry {
+        int index = -1;
+        std::string where;
+    };
+
+    LoadState& state_;
     Scene scene_;
     std::vector<std::string> stack_;  // canonical names of the open files
-    std::map<std::string, std::string> material_lines_, surface_lines_;  // name -> file:line
+    // Name look-ups in constant time: a scene of n surfaces is read in O(n), not O(n^2).
+    std::unordered_map<std::string, MaterialEntry> materials_;
+    std::unordered_map<std::string, std::string> surface_where_;  // name -> "file:line"
     std::set<std::string> settings_seen_;
     int camera_line_ = 0;
     Line depth_line_;
@@ -1364,8 +1446,8 @@ void open_top(const std::string& path, std::ifstream& in) {
 }  // namespace
 
 Scene parse_scene(std::istream& in, const std::string& name) {
-    FileBudget budget;
-    return SceneReader(budget).read(in, name);
+    LoadState state;
+    return SceneReader(state).read(in, name);
 }
 
 Scene load_scene(const std::string& path) {
@@ -1375,8 +1457,8 @@ Scene load_scene(const std::string& path) {
 }
 
 Scene parse_obj(std::istream& in, const std::string& name) {
-    FileBudget budget;
-    return ObjReader(name, budget).read(in);
+    LoadState state;
+    return ObjReader(name, state).read(in);
 }
 
 Scene load_obj(const std::string& path) {

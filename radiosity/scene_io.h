@@ -39,7 +39,10 @@ constexpr double max_coordinate = 1e8;
 
 /// Why four corners do not make a valid planar quad, or an empty string when they do: corners
 /// that coincide, zero area, self-intersection, non-planarity beyond planarity_tolerance, or a
-/// corner that is not strictly convex (a non-convex quad folds its bilinear map).
+/// corner that is not strictly convex (a non-convex quad folds its bilinear map). The tests are
+/// invariant under translation and scaling: they work relative to corner 0, in units of the
+/// largest coordinate difference, so that quads near max_coordinate cannot overflow and small
+/// quads far from the origin do not lose their shape to cancellation.
 std::string planar_quad_problem(const std::array<Vec3, 4>& corners);
 
 }  // namespace mbr

@@ -49,28 +49,52 @@ Texture Texture::checker(Rgb a, Rgb b, int n) {
     return t;
 }
 
+Rgb Texture::Pixels::texel(int x, int y) const {
+    const size_t i = size_t(y) * size_t(width) + size_t(x);
+    if (!srgb) return linear[i];
+    const unsigned char* c = srgb.get() + 3 * i;
+    return {decoded[c[0]], decoded[c[1]], decoded[c[2]]};
+}
+
+Texture Texture::from_shared(std::shared_ptr<const Pixels> pixels, Rgb scale,
+                             const std::string& name) {
+    Texture t;
+    t.kind_ = Kind::Image;
+    t.pixels_ = std::move(pixels);
+    t.scale_ = scale;
+    t.source_ = name;
+    return t;
+}
+
+namespace {
+
+/// Fills mean, lo and hi of the unscaled texels.
+template <typename Pixels>
+void summarize(Pixels& p) {
+    Rgb sum, lo{HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi{-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+    for (int y = 0; y < p.height; ++y)
+        for (int x = 0; x < p.width; ++x) {
+            const Rgb texel = p.texel(x, y);
+            sum += texel;
+            lo = channel_min(lo, texel);
+            hi = channel_max(hi, texel);
+        }
+    p.mean = sum * (1.0 / (double(p.width) * double(p.height)));
+    p.lo = lo;
+    p.hi = hi;
+}
+
+}  // namespace
+
 Texture Texture::from_pixels(int width, int height, std::vector<Rgb> linear, Rgb scale,
                              const std::string& name) {
     MBR_CHECK(width >= 1 && height >= 1 && linear.size() == size_t(width) * size_t(height));
     auto pixels = std::make_shared<Pixels>();
     pixels->width = width;
     pixels->height = height;
-    pixels->texels = std::move(linear);
-    Rgb sum, lo{HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi{-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
-    for (Rgb& texel : pixels->texels) {
-        texel = texel * scale;
-        sum += texel;
-        lo = channel_min(lo, texel);
-        hi = channel_max(hi, texel);
-    }
-    pixels->mean = sum * (1.0 / double(pixels->texels.size()));
-    pixels->lo = lo;
-    pixels->hi = hi;
-    Texture t;
-    t.kind_ = Kind::Image;
-    t.pixels_ = std::move(pixels);
-    t.source_ = name;
-    return t;
+    pixels->linear = std::move(linear);
+    summarize(*pixels);
+    return from_shared(std::move(pixels), scale, name);
 }
 
 Texture Texture::image(const std::string& path, Rgb scale) {
@@ -97,14 +121,24 @@ Texture Texture::image(const std::string& path, Rgb scale) {
             path, 0,
             std::string("cannot decode the texture image (") + (why ? why : "unknown error") + ")");
     }
+    auto pixels = std::make_shared<Pixels>();
+    pixels->width = width;
+    pixels->height = height;
+    pixels->srgb = std::shared_ptr<const unsigned char>(
+        data, [](const unsigned char* p) { stbi_image_free(const_cast<unsigned char*>(p)); });
     // sRGB decoding of the 256 possible 8-bit values, once.
-    double table[256];
-    for (int i = 0; i < 256; ++i) table[i] = srgb_to_linear(i / 255.0);
-    std::vector<Rgb> linear(size_t(width) * size_t(height));
-    for (size_t i = 0; i < linear.size(); ++i)
-        linear[i] = {table[data[3 * i]], table[data[3 * i + 1]], table[data[3 * i + 2]]};
-    stbi_image_free(data);
-    return from_pixels(width, height, std::move(linear), scale, path);
+    pixels->decoded.resize(256);
+    for (int i = 0; i < 256; ++i) pixels->decoded[size_t(i)] = srgb_to_linear(i / 255.0);
+    summarize(*pixels);
+    return from_shared(std::move(pixels), scale, path);
+}
+
+Texture Texture::scaled(Rgb scale) const {
+    Texture t = *this;
+    t.a_ = a_ * scale;
+    t.b_ = b_ * scale;
+    t.scale_ = scale_ * scale;
+    return t;
 }
 
 Rgb Texture::value(double u, double v) const {
@@ -128,9 +162,9 @@ Rgb Texture::value(double u, double v) const {
             int x0 = std::min(int(fx), p.width - 1), y0 = std::min(int(fy), p.height - 1);
             int x1 = std::min(x0 + 1, p.width - 1), y1 = std::min(y0 + 1, p.height - 1);
             double tx = fx - x0, ty = fy - y0;
-            auto at = [&](int x, int y) { return p.texels[size_t(y) * p.width + x]; };
-            return (1 - ty) * ((1 - tx) * at(x0, y0) + tx * at(x1, y0)) +
-                   ty * ((1 - tx) * at(x0, y1) + tx * at(x1, y1));
+            Rgb blend = (1 - ty) * ((1 - tx) * p.texel(x0, y0) + tx * p.texel(x1, y0)) +
+                        ty * ((1 - tx) * p.texel(x0, y1) + tx * p.texel(x1, y1));
+            return scale_ * blend;
         }
     }
     return {};
@@ -143,7 +177,7 @@ bool Texture::is_constant() const {
         case Kind::Checker:
             return a_ == b_ || n_ == 1;
         case Kind::Image:
-            return pixels_->lo == pixels_->hi;
+            return minimum() == maximum();
     }
     return true;
 }
@@ -159,7 +193,7 @@ Rgb Texture::mean() const {
             return (double(n_a) * a_ + double(n2 - n_a) * b_) * (1.0 / double(n2));
         }
         case Kind::Image:
-            return pixels_->mean;
+            return scale_ * pixels_->mean;
     }
     return {};
 }
@@ -170,8 +204,8 @@ Rgb Texture::minimum() const {
             return a_;
         case Kind::Checker:
             return n_ == 1 ? a_ : channel_min(a_, b_);
-        case Kind::Image:
-            return pixels_->lo;
+        case Kind::Image:  // a negative scale turns the range around
+            return channel_min(scale_ * pixels_->lo, scale_ * pixels_->hi);
     }
     return {};
 }
@@ -183,7 +217,7 @@ Rgb Texture::maximum() const {
         case Kind::Checker:
             return n_ == 1 ? a_ : channel_max(a_, b_);
         case Kind::Image:
-            return pixels_->hi;
+            return channel_max(scale_ * pixels_->lo, scale_ * pixels_->hi);
     }
     return {};
 }

@@ -12,7 +12,9 @@
 
 namespace mbr {
 
-/// A field of RGB values over (u,v) in [0,1]^2. Copies are cheap (image texels are shared).
+/// A field of RGB values over (u,v) in [0,1]^2. Copies are cheap: image texels are shared, and
+/// so are they between an image and its scaled() copies, so one image file costs its memory
+/// once however many materials use it.
 class Texture {
 public:
     /// The three kinds of field.
@@ -33,6 +35,9 @@ public:
     /// An image from linear texel values, row 0 at the top (v = 1), width * height of them.
     static Texture from_pixels(int width, int height, std::vector<Rgb> linear, Rgb scale,
                                const std::string& name = "");
+    /// This field multiplied channel by channel by `scale`. An image's copy shares its texels
+    /// (only the scale differs), so scaling costs no memory.
+    Texture scaled(Rgb scale) const;
 
     /// Largest image accepted (pixels), a guard against absurd headers and memory exhaustion.
     static constexpr long max_image_pixels = 1L << 25;
@@ -55,16 +60,30 @@ public:
     const std::string& source() const { return source_; }
     /// Checker squares per side (0 for the other kinds).
     int checker_squares() const { return n_; }
+    /// True when both are images reading one and the same texel storage (one decoded file).
+    bool shares_texels(const Texture& other) const {
+        return pixels_ != nullptr && pixels_ == other.pixels_;
+    }
 
 private:
+    // Unscaled texels, row 0 at the top (v = 1), in one of two forms: linear values (from_pixels)
+    // or the file's 8-bit sRGB codes with their 256 decoded values (image: 3 bytes a texel
+    // instead of 24, and the same doubles as decoding each texel up front). The codes stay in
+    // the buffer stb_image decoded them into, so loading never holds two copies.
     struct Pixels {
         int width = 0, height = 0;
-        std::vector<Rgb> texels;  // linear, already scaled; row 0 is the top (v = 1)
-        Rgb mean, lo, hi;
+        std::vector<Rgb> linear;                    // from_pixels
+        std::shared_ptr<const unsigned char> srgb;  // image: r, g, b codes of each texel
+        std::vector<double> decoded;  // image: srgb_to_linear(code / 255) for the 256 codes
+        Rgb mean, lo, hi;             // of the unscaled texels
+        Rgb texel(int x, int y) const;
     };
+    static Texture from_shared(std::shared_ptr<const Pixels> pixels, Rgb scale,
+                               const std::string& name);
     Kind kind_ = Kind::Constant;
-    Rgb a_, b_;  // constant value; checker colours
-    int n_ = 0;  // checker squares per side
+    Rgb a_, b_;           // constant value; checker colours
+    int n_ = 0;           // checker squares per side
+    Rgb scale_{1, 1, 1};  // an image's scale, applied to its texels on lookup
     std::shared_ptr<const Pixels> pixels_;
     std::string source_;
 };

@@ -5,13 +5,14 @@
 // more than a second, fails with the seed and the iteration so the case can be replayed.
 #include <unistd.h>
 
-#include <catch2/catch.hpp>
 #include <algorithm>
+#include <catch2/catch.hpp>
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <random>
+#include <set>
 #include <sstream>
 
 #include "math/check.h"
@@ -190,7 +191,10 @@ std::string mutate(std::string text, std::mt19937_64& rng) {
 /// What the readers promise about every scene they return.
 void check_scene(const Scene& s) {
     REQUIRE(!s.surfaces.empty());
+    std::set<std::string> names;
     for (const SceneSurface& x : s.surfaces) {
+        INFO("surface " << x.name);
+        REQUIRE(names.insert(x.name).second);  // names are unique, OBJ group numbering included
         REQUIRE(x.material >= 0);
         REQUIRE(size_t(x.material) < s.materials.size());
         double a = x.surface.area();

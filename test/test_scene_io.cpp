@@ -257,7 +257,7 @@ TEST_CASE("scene_io: NaN and infinity", "[scene_io][errors]") {
     check_error(white + "quad q white 0 0 0  1 0 0  1 1 0  0 1 0x10\n", 2,
                 "expected a number for quad p01.z, found '0x10'");
     check_error(white + "quad q white 0 0 0  1e300 0 0  1 1 0  0 1 0\n", 2,
-                "coordinate 1e+300 exceeds the limit 1e+08");
+                "coordinate 1e+300 exceeds the limit 100000000");
 }
 
 TEST_CASE("scene_io: reflectance out of range", "[scene_io][errors]") {
@@ -347,7 +347,7 @@ TEST_CASE("scene_io: missing or unreadable texture", "[scene_io][errors]") {
 
 TEST_CASE("scene_io: bad OBJ index", "[scene_io][errors][obj]") {
     const std::string v3 = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
-    check_obj_error(v3 + "f 1 2 4\n", 4, "vertex index 4 is out of range (3 vertexs defined");
+    check_obj_error(v3 + "f 1 2 4\n", 4, "vertex index 4 is out of range (3 vertices defined");
     check_obj_error(v3 + "f 1 2 0\n", 4, "vertex index 0 is not allowed");
     check_obj_error(v3 + "f -1 -2 -4\n", 4, "vertex index -4 is out of range");
     check_obj_error(v3 + "f 1/1 2/1 3/1\n", 4, "texture vertex index 1 is out of range");
@@ -703,4 +703,234 @@ TEST_CASE("scene_io: textures decode sRGB and look up bilinearly", "[scene_io][t
         for (int j = 0; j < n; ++j) sum += img.value((i + 0.5) / n, (j + 0.5) / n);
     CHECK(sum.g / (n * n) == Approx(img.mean().g).epsilon(1e-3));
     CHECK(img.maximum().r <= 0.9);
+}
+
+// === Scenes of any size, bounded texture memory, clear messages
+
+TEST_CASE("scene_io: many surfaces keep unique names; duplicates name the first use",
+          "[scene_io][errors]") {
+    // 3000 surfaces (the name look-up is a hash map; this checks that it still finds every
+    // duplicate, whether the first use is early, late, in a box or in an OBJ import).
+    std::string text = white;
+    for (int i = 0; i < 3000; ++i)
+        text += "rectangle r" + std::to_string(i) + " white " + std::to_string(i) +
+                " 0 0  1 0 0  0 1 0\n";
+    CHECK(parse_text(text).surfaces.size() == 3000);
+    check_error(text + "rectangle r0 white 0 0 5  1 0 0  0 1 0\n", 3002,
+                "duplicate surface name 'r0' (first used at " + text_name + ":2)");
+    check_error(text + "rectangle r2999 white 0 0 5  1 0 0  0 1 0\n", 3002,
+                "(first used at " + text_name + ":3001)");
+    check_error(text + "box r17 white 0 0 0 1 1 1\nbox b white 0 0 0 1 1 1\nquad b.ymax white " +
+                    "0 0 0  1 0 0  1 1 0  0 1 0\n",
+                3004, "duplicate surface name 'b.ymax' (first used at " + text_name + ":3003)");
+    TempDir dir;
+    dir.write("one.obj", "g r5\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n");
+    const std::string scene = dir.write("s.scene", text + "obj one.obj\n");
+    try {
+        load_scene(scene);
+        FAIL("no error for an OBJ surface named like an earlier one");
+    } catch (const InputError& e) {
+        CHECK(e.line() == 3002);
+        CHECK_THAT(e.message(), Contains("surface 'r5' of '"));
+        CHECK_THAT(e.message(),
+                   Contains("has the name of an earlier surface (at " + scene + ":7)"));
+    }
+}
+
+TEST_CASE("scene_io: quads near the coordinate limit or far from the origin are judged alike",
+          "[scene_io]") {
+    // The same unit square, with and without a twist, at the origin and translated by t: the
+    // verdicts must agree. Relative to corner 0 the corners are exact (Sterbenz), so even a
+    // quad of size 1e-3 at 99999999 is judged as at the origin; in absolute coordinates, its
+    // Newell normal drowned in cancellation and convex quads were called non-convex.
+    for (double t : {0.0, 1e4, 99999999.0, -99999999.0})
+        for (double size : {1.0, 1e-3}) {
+            CAPTURE(t, size);
+            const Vec3 o{t, t, t};
+            std::array<Vec3, 4> flat = {o, o + Vec3{size, 0, 0}, o + Vec3{size, size, 0},
+                                        o + Vec3{0, size, 0}};
+            CHECK(planar_quad_problem(flat).empty());
+            // A square rotated out of the axis planes (its corners round at 1e8).
+            const Vec3 eu = Vec3{0.6, 0.8, 0} * size, ev = Vec3{0, 0, 1} * size;
+            CHECK(planar_quad_problem({o, o + eu, o + eu + ev, o + ev}).empty());
+            // Twisted by 10% of its size: refused, with a finite deviation in the message.
+            std::array<Vec3, 4> twisted = flat;
+            twisted[2].z += 0.1 * size;
+            const std::string problem = planar_quad_problem(twisted);
+            CHECK_THAT(problem, Contains("quad is not planar: a corner lies "));
+            CHECK_THAT(problem, !Contains("inf") && !Contains("nan"));
+            // 1.75897% at the origin. At 1e8 the corners themselves round to 1.5e-8, 1.5e-5 of
+            // the smaller size, which moves the percentage in its fourth digit at most.
+            const size_t end = problem.find("% of its size");
+            const size_t begin = problem.rfind(' ', end) + 1;
+            REQUIRE(end != std::string::npos);
+            CHECK(std::stod(problem.substr(begin, end - begin)) == Approx(1.75897).epsilon(1e-3));
+            // A dart stays non-convex, a bow tie self-intersecting, wherever they are.
+            CHECK_THAT(
+                planar_quad_problem({o, o + Vec3{2, 0, 0} * size, o + Vec3{0.5, 0.5, 0} * size,
+                                     o + Vec3{0, 2, 0} * size}),
+                Contains("not convex at corner 3"));
+            CHECK_THAT(planar_quad_problem({o, o + Vec3{1, 1, 0} * size, o + Vec3{1, 0, 0} * size,
+                                            o + Vec3{0, 1, 0} * size}),
+                       Contains("intersects itself"));
+        }
+    // Far beyond the file limit (the function is public): squared sizes of 1e400 no longer
+    // overflow into "zero area".
+    const double big = 1e200;
+    CHECK(planar_quad_problem({Vec3{0, 0, 0}, Vec3{big, 0, 0}, Vec3{big, big, 0}, Vec3{0, big, 0}})
+              .empty());
+    CHECK(planar_quad_problem(
+              {Vec3{0, 0, 0}, Vec3{1e-200, 0, 0}, Vec3{1e-200, 1e-200, 0}, Vec3{0, 1e-200, 0}})
+              .empty());
+    CHECK_THAT(planar_quad_problem({Vec3{1, 2, 3}, Vec3{1, 2, 3}, Vec3{1, 2, 3}, Vec3{1, 2, 3}}),
+               Contains("all corners coincide"));
+    // Through the reader: a quad spanning the whole allowed range and a tiny tilted rectangle at
+    // the limit both load.
+    CHECK(parse_text(white +
+                     "quad q white 1e8 1e8 -1e8  -1e8 1e8 1e8  -1e8 -1e8 1e8  1e8 -1e8 -1e8\n")
+              .surfaces.size() == 1);
+    CHECK(parse_text(white + "rectangle r white 99999999 99999999 99999999  0.0006 0.0008 0  "
+                             "0 0 0.001\n")
+              .surfaces.size() == 1);
+}
+
+TEST_CASE("scene_io: OBJ faces far from the origin keep their vertices", "[scene_io][obj]") {
+    // A small planar quad and a triangle at 99999999: the quad stays one quad with exactly the
+    // given corners, the triangle becomes three quads of its area.
+    Scene s = parse_obj_text(
+        "v 99999999 99999999 99999999\nv 99999999.001 99999999 99999999\n"
+        "v 99999999.001 99999999.001 99999999.0005\nv 99999999 99999999.001 99999999.0005\n"
+        "g quad\nf 1 2 3 4\ng tri\nf 1 2 3\n");
+    REQUIRE(s.surfaces.size() == 4);
+    CHECK(s.surfaces[0].name == "quad");
+    const Vec3* c = s.surfaces[0].surface.corners();
+    CHECK(c[0] == Vec3{99999999, 99999999, 99999999});
+    CHECK(c[2] == Vec3{99999999.001, 99999999.001, 99999999.0005});
+    double tri_area = 0;
+    for (int i = 1; i < 4; ++i) tri_area += s.surfaces[i].surface.area();
+    // 1/2 |e1 x e2| with the parsed corner differences. The quads' new corners (midpoints and
+    // centroid) round to the spacing of doubles near 1e8, 1.5e-8, which is 1.5e-5 of the
+    // triangle's 1e-3 edges: their areas may differ by a few times that.
+    const Vec3 e1 = Vec3{99999999.001, 99999999, 99999999} - Vec3{99999999, 99999999, 99999999};
+    const Vec3 e2 =
+        Vec3{99999999.001, 99999999.001, 99999999.0005} - Vec3{99999999, 99999999, 99999999};
+    CHECK(tri_area == Approx(0.5 * length(cross(e1, e2))).epsilon(1e-4));
+}
+
+TEST_CASE("scene_io: messages print numbers that read back as themselves", "[scene_io][errors]") {
+    check_error(white + "quad q white 100000000.1 0 0  1 0 0  1 1 0  0 1 0\n", 2,
+                "corner coordinate 100000000.1 exceeds the limit 100000000");
+    check_error(white + "cylinder c white 0 0 0  0 0 1  1 0 0  100000000.5 1  0 360\n", 2,
+                "radius 100000000.5 exceeds the limit 100000000");
+    check_error("material m reflectance 0.5 1.0000000000000002 0.5\n", 1,
+                "reflectance 1.0000000000000002 is outside [0, 1)");
+    check_error("set oracle_tolerance 1.00000000001\n", 1,
+                "oracle_tolerance 1.00000000001 is outside (0, 1]");
+    check_error(white + "quad q white 1e-320 0 0  1 0 0  1 1 0  0 1 0\n" + square +
+                    "disk d white 0 0 0  0 0 1  1 0 0  0.30000000000000004 0.3  0 360\n",
+                4, "disk r1 0.3 must exceed r0 0.30000000000000004");
+}
+
+TEST_CASE("scene_io: OBJ group names never collide", "[scene_io][obj]") {
+    const std::string v4 = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n";
+    auto names = [&](const std::string& groups) {
+        std::vector<std::string> out;
+        for (const SceneSurface& s : parse_obj_text(v4 + groups).surfaces) out.push_back(s.name);
+        return out;
+    };
+    using V = std::vector<std::string>;
+    // A group 'a' of two faces and a group named 'a.0': the numbering skips the taken 'a.0',
+    // whichever comes first in the file.
+    CHECK(names("g a\nf 1 2 3 4\nf 1 2 3 4\ng a.0\nf 1 2 3 4\n") == V{"a.1", "a.2", "a.0"});
+    CHECK(names("g a.0\nf 1 2 3 4\ng a\nf 1 2 3 4\nf 1 2 3 4\n") == V{"a.0", "a.1", "a.2"});
+    // A group 'a.1' of several faces is numbered in its own right; 'a' may then use 'a.1'.
+    CHECK(names("g a\nf 1 2 3 4\nf 1 2 3 4\ng a.1\nf 1 2 3 4\nf 1 2 3 4\n") ==
+          V{"a.0", "a.1", "a.1.0", "a.1.1"});
+    // A triangle is three surfaces of its group; the file's stem names faces without a group.
+    CHECK(names("f 1 2 3\ng inline.1\nf 1 2 3 4\n") ==
+          V{"inline.0", "inline.2", "inline.3", "inline.1"});
+    // And the unique names go through an `obj` statement into a scene without complaint.
+    TempDir dir;
+    dir.write("g.obj", v4 + "g a\nf 1 2 3 4\nf 1 2 3 4\ng a.0\nf 1 2 3 4\n");
+    CHECK(load_scene(dir.write("g.scene", "obj g.obj\n")).surfaces.size() == 3);
+}
+
+TEST_CASE("scene_io: counts in messages agree with their nouns", "[scene_io][errors]") {
+    check_error("set order\n", 1, "'set' needs a name and one value, found 1 word");
+    check_error("set order 3 4\n", 1, "'set' needs a name and one value, found 3 words");
+    check_obj_error("v 0 0 0\nf 1 2 3\n", 2, "vertex index 2 is out of range (1 vertex defined");
+    check_obj_error("v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1/1 2/2 3/1\n", 5,
+                    "texture vertex index 2 is out of range (1 texture vertex defined");
+    check_obj_error("v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nf 1/1 2/3 3/1\n", 6,
+                    "(2 texture vertices defined");
+    check_obj_error("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1//1 2//1 3//1\n", 4,
+                    "normal index 1 is out of range (0 normals defined");
+}
+
+TEST_CASE("scene_io: an image named by several materials is decoded once", "[scene_io][texture]") {
+    // Four materials of one scene and one material of an imported OBJ name the same file (once
+    // through a different spelling of its path): all five share one decoded image.
+    TempDir dir;
+    std::filesystem::copy_file(scenes_dir + "picture.png", dir.path / "big.png");
+    std::filesystem::create_directories(dir.path / "sub");
+    dir.write("t.mtl", "newmtl poster\nKd 0.5 0.5 0.5\nmap_Kd big.png\n");
+    dir.write("t.obj",
+              "mtllib t.mtl\nusemtl poster\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
+              "f 1 2 3 4\n");
+    const std::string text =
+        "material a reflectance image big.png\n"
+        "material b reflectance image big.png scale 0.3 0.6 0.45\n"
+        "material c emission image sub/../big.png scale 20 20 20\n"
+        "material d reflectance 0.5 0.5 0.5 emission image big.png\n"
+        "rectangle r a 0 0 0  1 0 0  0 1 0\n"
+        "obj t.obj\n";
+    Scene s = load_scene(dir.write("t.scene", text));
+    REQUIRE(s.materials.size() == 5);
+    const Texture& first = s.materials[0].reflectance;
+    REQUIRE(first.kind() == Texture::Kind::Image);
+    CHECK(first.shares_texels(s.materials[1].reflectance));
+    CHECK(first.shares_texels(s.materials[2].emission));
+    CHECK(first.shares_texels(s.materials[3].emission));
+    CHECK(first.shares_texels(s.materials[4].reflectance));
+    CHECK(!first.shares_texels(s.materials[3].reflectance));  // a constant has no texels
+    // Each keeps its own scale: b = a x (0.3 0.6 0.45) / 0.9 at every point; the OBJ's map_Kd
+    // is scaled by its Kd.
+    for (Vec2 uv : {Vec2{0.1, 0.2}, Vec2{0.5, 0.5}, Vec2{0.93, 0.7}}) {
+        const Rgb a = first.value(uv.x, uv.y) * (1 / 0.9);
+        const Rgb b = s.materials[1].reflectance.value(uv.x, uv.y);
+        const Rgb c = s.materials[2].emission.value(uv.x, uv.y);
+        const Rgb p = s.materials[4].reflectance.value(uv.x, uv.y);
+        // Products of the same doubles in a different order: a few ulps apart.
+        CHECK(b.g == Approx(0.6 * a.g).epsilon(1e-14));
+        CHECK(b.b == Approx(0.45 * a.b).epsilon(1e-14));
+        CHECK(c.r == Approx(20 * a.r).epsilon(1e-14));
+        CHECK(p.r == Approx(0.5 * a.r).epsilon(1e-14));
+    }
+    // A memory-independent check that the file is read once: the scene's budget of 1000 files
+    // read counts it once, so 1500 materials may name it.
+    std::string many;
+    for (int i = 0; i < 1500; ++i)
+        many += "material m" + std::to_string(i) + " reflectance image big.png\n";
+    Scene m = load_scene(dir.write("many.scene", many + "rectangle r m7 0 0 0  1 0 0  0 1 0\n"));
+    CHECK(m.materials.size() == 1500);
+    CHECK(m.materials[0].reflectance.shares_texels(m.materials[1499].reflectance));
+}
+
+TEST_CASE("texture: scaled copies share the texels and scale every statistic",
+          "[scene_io][texture]") {
+    Texture t = Texture::from_pixels(2, 1, {{0.2, 0.4, 0.8}, {0.6, 0.1, 0.0}}, {1, 1, 1});
+    Texture s = t.scaled({2, 1, -1});
+    CHECK(s.shares_texels(t));
+    CHECK(s.value(0.25, 0.5).r == 0.4);
+    CHECK(s.value(0.75, 0.5).b == 0);
+    CHECK(s.mean().r == Approx(0.8));  // 2 x mean 0.4
+    CHECK(s.maximum().r == 1.2);
+    // A negative scale turns the range around: minimum -0.8, maximum -0 for blue.
+    CHECK(s.minimum().b == -0.8);
+    CHECK(s.maximum().b == 0);
+    CHECK(Texture::constant({0.5, 0.5, 0.5}).scaled({0.5, 1, 2}).value(0.3, 0.3).b == 1);
+    Texture c = Texture::checker({1, 1, 1}, {0.5, 0.5, 0.5}, 2).scaled({0.5, 0.5, 0.5});
+    CHECK(c.value(0.1, 0.1).r == 0.5);
+    CHECK(c.value(0.6, 0.1).r == 0.25);
+    CHECK(!c.shares_texels(c));  // procedural: no texels
 }
