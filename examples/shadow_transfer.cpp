@@ -27,13 +27,13 @@
 #include <array>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <sstream>
 
 #include "examples/common/cli.h"
 #include "examples/common/plot.h"
 #include "examples/common/transfer_cli.h"
+#include "radiosity/output_file.h"
 #include "radiosity/scene_io.h"
 
 namespace mbr {
@@ -201,7 +201,7 @@ Image compose(const Run& run, const std::vector<double>& exact, int n, const std
 int run(Args& args) {
     const std::string which = args.text("--config", "all");
     const std::string method = args.text("--method", "fractions");
-    const int one_depth = args.integer("--max-shadow-depth", 0);
+    const int one_depth = args.integer("--max-shadow-depth", 0, 1, 10);
     const bool csv = args.flag("--csv");
     const std::string grid_path = args.text("--grid", "");
     const std::string dir = args.text("-o", "");
@@ -219,7 +219,7 @@ int run(Args& args) {
         configs.push_back({"custom", setup});
     }
     ReceiverOptions options = read_receiver_options(args);
-    options.shadows.rays_per_patch = args.integer("--rays", options.shadows.rays_per_patch);
+    options.shadows.rays_per_patch = args.integer("--rays", options.shadows.rays_per_patch, 1, 4096);
     options.shadows.threshold = args.number("--threshold", options.shadows.threshold);
     options.oracle_tolerance = args.number("--oracle-tolerance", options.oracle_tolerance);
     const std::string oracle = args.text("--oracle", "means");
@@ -235,10 +235,6 @@ int run(Args& args) {
         options.shadows.method = ShadowMethod::Exact;
     else
         throw UsageError("--method must be fractions or exact");
-    if (args.has("--max-shadow-depth") && (one_depth < 1 || one_depth > 10))
-        throw UsageError("--max-shadow-depth must be in 1..10");
-    if (options.shadows.rays_per_patch < 1 || options.shadows.rays_per_patch > 4096)
-        throw UsageError("--rays must be in 1..4096");
     if (!(options.shadows.threshold > 0 && options.shadows.threshold <= 1))
         throw UsageError("--threshold must be in (0, 1]");
     if (!custom) {
@@ -251,7 +247,8 @@ int run(Args& args) {
             configs.push_back({"umbra", occluded_squares(0, 0.3)});
     }
     if (!dir.empty() && !std::filesystem::is_directory(dir))
-        throw InputError(dir, 0, "the output directory does not exist");
+        throw OutputError(dir, "the output directory does not exist");
+    if (!grid_path.empty()) check_output_path(grid_path);
     std::vector<int> depths;
     if (one_depth > 0)
         depths = {one_depth};
@@ -311,9 +308,7 @@ int run(Args& args) {
         os.precision(17);
         for (int i = 0; i < n; ++i)  // s slowest
             for (int j = 0; j < n; ++j) os << last.values[size_t(j) * n + i] << "\n";
-        std::ofstream out(grid_path);
-        if (!(out << os.str()) || !out.flush())
-            throw InputError(grid_path, 0, "cannot write the grid");
+        write_file(grid_path, os.str());
         if (!csv)
             std::cout << "wrote " << grid_path << " (" << last.config << ", depth " << last.depth
                       << ")\n";
