@@ -73,6 +73,28 @@ IncrementIntegrator::IncrementIntegrator(const Shooter& shooter, const Quadratur
         for (int n = 1; n <= options.n + 1; ++n) tri_rules_[n] = triangle_rule(n);
     }
     if (occlusion && !occlusion->clear()) occlusion_ = occlusion;
+    analytic_ = planar_ && unshot_constant_ && options.analytic;
+}
+
+Rgb IncrementIntegrator::analytic_value(const SurfacePoint& p) {
+    // Eq. (21) for a constant B_h over a planar polygon: B_h times the form factor from p to
+    // the part of the shooter p sees, by the contour formula of the reference (Baum et al.
+    // 1989), piece by piece (each convex, counter-clockwise seen from the shooter's front).
+    set_view(p);
+    if (view_.behind_all) return Rgb{};
+    std::vector<ConvexPolygon> pieces;
+    if (view_.trivial())
+        pieces.push_back(plane_.outline);
+    else
+        pieces = visible_pieces(plane_.outline, view_);
+    double F = 0;
+    std::vector<Vec3> polygon;
+    for (const ConvexPolygon& piece : pieces) {
+        polygon.clear();
+        for (const Vec2& q : piece) polygon.push_back(plane_.to_space(q));
+        F += point_polygon_form_factor(p.position, p.normal, polygon);
+    }
+    return F * shooter_.unshot.coefficient(0, 0);
 }
 
 IncrementIntegrator::PointSpan IncrementIntegrator::points(const QuadCell& cell, int n) {
@@ -214,6 +236,10 @@ Rgb IncrementIntegrator::cell_value(const SurfacePoint& p, const QuadCell& cell,
 IncrementIntegrator::Result IncrementIntegrator::integrate(const SurfacePoint& p,
                                                            bool keep_partition, int min_depth) {
     Result result;
+    if (analytic_ && !keep_partition) {
+        result.value = analytic_value(p);
+        return result;
+    }
     set_view(p);
     if (view_.behind_all) return result;  // the whole shooter is behind p: nothing arrives
     // The tolerance is relative to the (n+1)-point estimate over the whole shooter, with a

@@ -56,6 +56,10 @@ struct QuadratureOptions {
     bool global = false;          // refine the worst cell first until the error estimates sum
                                   //   to the tolerance (AdaptiveOptions::global), instead of
                                   //   the paper's quarter tolerance per child
+    bool analytic = true;         // a planar quad shooter of constant radiosity (an emitter's
+                                  //   first shot): I(p) by the contour formula over the
+                                  //   visible pieces, no quadrature (not when a partition is
+                                  //   asked for)
     bool clip_horizon = true;     // planar shooters: integrate cells the receiving point's
                                   //   tangent plane cuts over their front part only (exact
                                   //   convex pieces), instead of chasing the kink of the
@@ -109,6 +113,8 @@ public:
         int count;
     };
     PointSpan points(const QuadCell& cell, int n);
+    /// True when integrate() uses the closed form (QuadratureOptions::analytic).
+    bool analytic() const { return analytic_; }
 
 private:
     Rgb sum_over(const SurfacePoint& p, PointSpan pts) const;
@@ -117,6 +123,7 @@ private:
     /// a curved shooter with an occlusion context.
     Rgb cell_value(const SurfacePoint& p, const QuadCell& cell, int n);
     void set_view(const SurfacePoint& p);
+    Rgb analytic_value(const SurfacePoint& p);
     ConvexPolygon cell_image(const QuadCell& cell) const;
     Rgb pieces_value(const SurfacePoint& p, const std::vector<ConvexPolygon>& pieces, int n);
 
@@ -124,6 +131,7 @@ private:
     QuadratureOptions options_;
     const OcclusionContext* occlusion_ = nullptr;  // exact visibility when set (and not clear)
     bool planar_ = false;               // the shooter is a planar quad: exact clipping works
+    bool analytic_ = false;             // and of constant radiosity: closed form
     ShooterPlane plane_;                // its frame
     BlockedView view_;                  // what the current point cannot see
     std::vector<TriangleRule> tri_rules_;  // tri_rules_[n]

@@ -108,6 +108,12 @@ void IncrementSampler::sample_pair(double s, double t, double ds, double dt, int
                                    Rgb& at_p, Rgb& at_q, long* n_kernel_evals) {
     IncrementIntegrator& integrator = *integrators_[thread];
     const SurfacePoint p = receiver_.surface->evaluate(s, t);
+    if (integrator.analytic()) {  // closed form at both points: no partition to share
+        const SurfacePoint q = receiver_.surface->evaluate(s + ds, t + dt);
+        at_p = receiver_.reflectance(s, t) * integrator.integrate(p).value;
+        at_q = receiver_.reflectance(s + ds, t + dt) * integrator.integrate(q).value;
+        return;
+    }
     const IncrementIntegrator::Result r = integrator.integrate(p, true);
     const SurfacePoint q = receiver_.surface->evaluate(s + ds, t + dt);
     long evals = r.n_evaluations;
