@@ -460,8 +460,8 @@ TEST_CASE("shadow: polygons_near equals the leaves' lists brute-forced over node
         const Box3 cube = cubes[i];
         std::vector<int> list =
             octree.polygons_near([&](const Box3& b) { return contains(b, cube); });
-        // A leaf lists only polygons that meet its grown cube (the node test never over-reports
-        // beyond its step 3, which is exact for convex polygons after steps 1 and 2).
+        // A leaf lists only polygons the node test accepts for its grown cube (the build filters
+        // each child's list with it).
         for (int id : list) CHECK(node_meets_polygon(cube, scene[id]));
         leaves.push_back({cube, ancestors, list});
     }
@@ -1117,7 +1117,11 @@ TEST_CASE("shadow: exact visibility when a shadow's vertex lies on the shooter's
     // (b) the triangle (-1,-1) (3,-1) (3,3) in z = 0.5 (the half x >= y), whose shadow's edge
     //     runs through the shooter's corners (0,0) and (1,1): expected half the form factor,
     //     0.119728; got 0.239456 (the same at every point of the receiver's diagonal s = t).
-    // Each case is checked first at p moved by 1e-9 in t, where the code is right.
+    // Each case is checked first at p moved by 1e-9 in t, where the code is right. In a whole
+    // transfer (the Gauss nodes of the receiver's diagonal leaves lie on s = t): shadow_transfer
+    // --method exact --max-shadow-depth 3 with the custom occluder (-1,-1,.5) (1,-1,.5) (3,1,.5)
+    // (3,3,.5) measures rea 8.39 % (L1 6.2 %), against 0.64 % (L1 0.42 %) with its first and
+    // last vertices moved by 1e-3 so that the shadow's edge misses the shooter's corners.
     const std::vector<Vec3> cases[] = {
         {{0.5, 0.25, 0.5}, {0.65, 0, 0.5}, {0.85, 0.55, 0.5}, {0.4, 0.6, 0.5}},
         {{-1, -1, 0.5}, {3, -1, 0.5}, {3, 3, 0.5}},
