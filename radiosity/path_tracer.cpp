@@ -239,10 +239,10 @@ Rgb direct_light(const Context& ctx, const Vertex& x, PathRng& rng) {
 // the edge itself a neighbouring surface that meets it there is hit at t < t_min by every ray
 // entering it, and its light would leak; a little inside, the path's next vertices near the edge
 // still fall within self_eps of the neighbour too often. Measured at a corner of the emitting
-// cube of test_path_tracer (512000 paths): 30 % low at the corner itself, 0.2 % low (8 standard
-// errors) at 10 self_eps, 0.04 % (1.7 standard errors) at 1000 self_eps. The radiosity there is
-// the limit from inside the surface. Where a tangent vanishes (a pole, a disk's centre) the
-// move along that parameter does not move the point.
+// cube of test_path_tracer: 37 % low at the corner itself (64000 paths), 0.2 % low (8 standard
+// errors, 512000 paths) at 10 self_eps, 0.04 % (1.7 standard errors) at 1000 self_eps. The
+// radiosity there is the limit from inside the surface. Where a tangent vanishes (a pole, a disk's
+// centre) the move along that parameter does not move the point.
 Vertex start_vertex(const Context& ctx, const SurfaceLocation& start) {
     const Surface& s = ctx.scene.surfaces[start.surface].surface;
     Vec3 x_u, x_v;

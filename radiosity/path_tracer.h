@@ -48,8 +48,9 @@ struct RadiosityEstimate {
 /// emission is dropped and D is next-event estimation alone.
 /// Deviation: multiple importance is the default. Next-event estimation alone has infinite
 /// variance wherever an emitter meets a receiving surface (1 / r^2 of the light sample near the
-/// common edge): on the emitting cube of test_path_tracer it reads 30 % low at a corner and
-/// its standard errors are unreliable; with the power heuristic every sample is bounded.
+/// common edge): on the emitting cube of test_path_tracer (64000 paths) it reads 20 % low near
+/// a corner with a standard error that claims 6 %, and elsewhere its standard errors are 4 to
+/// 26 times those of the power heuristic, whose samples are all bounded.
 /// After options.min_bounces_before_roulette bounces a path goes on with probability
 /// q = min(1, max channel of its weight) and the weight is divided by q.
 /// Self-hits: a ray ignores hits nearer than 1e-7 of the scene's diagonal to its origin (and to
