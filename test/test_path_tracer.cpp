@@ -111,6 +111,39 @@ TEST_CASE("path_tracer: a closed box of emitting faces has B = E / (1 - rho)", "
     }
 }
 
+TEST_CASE("path_tracer: closed curved enclosures of emitting surfaces have B = E / (1 - rho)",
+          "[path_tracer]") {
+    // The same closed form inside a whole inward sphere, and inside a can (an inward cylinder
+    // closed by two disks): paths live on the true surfaces while rays meet their facets, and
+    // on a concave surface the true points lie behind the facets. Rays leaving from the points
+    // themselves lost 5-11 % here (tessellation 16); from points moved in front of the facets
+    // the loss is of the order of the chord error: measured 0.2-0.6 % at tessellation 16, within
+    // 0.12 % (2 standard errors of 64000 paths) at 64. Tessellation 32 keeps it well below the
+    // 4 standard errors (about 1.4 %) of 2000 paths.
+    Scene sphere = cube_scene();
+    sphere.surfaces = {
+        {"sphere", Surface::sphere({0, 0, 0}, {0, 0, 1}, {1, 0, 0}, 1, 0, Pi, 0, 2 * Pi, true), 0}};
+    Scene can = cube_scene();
+    can.surfaces = {
+        {"wall", Surface::cylinder({0, 0, 0}, {0, 0, 1}, {1, 0, 0}, 1, 1, 0, 2 * Pi, true), 0},
+        {"bottom", Surface::disk({0, 0, 0}, {0, 0, 1}, {1, 0, 0}, 0, 1, 0, 2 * Pi), 0},
+        {"top", Surface::disk({0, 0, 1}, {0, 0, -1}, {1, 0, 0}, 0, 1, 0, 2 * Pi), 0}};
+    const Rgb exact{cube_E.r / (1 - cube_rho.r), cube_E.g / (1 - cube_rho.g),
+                    cube_E.b / (1 - cube_rho.b)};
+    for (Scene* scene : {&sphere, &can}) {
+        scene->settings.tessellation = 32;
+        const Octree octree = build_octree(*scene);
+        const int last = static_cast<int>(scene->surfaces.size()) - 1;
+        const std::vector<SurfaceLocation> points = {
+            at(*scene, 0, 0.5, 0.05), at(*scene, 0, 0.2, 0.9), at(*scene, last, 0.77, 0.5)};
+        PathTracerOptions options;
+        options.paths = 2000;
+        CAPTURE(scene->surfaces[0].name);
+        for (const RadiosityEstimate& e : estimate_radiosity(*scene, octree, points, options))
+            check_within_4se(e, exact);
+    }
+}
+
 TEST_CASE("path_tracer: the standard error matches the spread of independent runs",
           "[path_tracer]") {
     // 24 runs with different seeds: the standard deviation of their means estimates the true
