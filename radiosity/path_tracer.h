@@ -54,8 +54,11 @@ struct RadiosityEstimate {
 /// After options.min_bounces_before_roulette bounces a path goes on with probability
 /// q = min(1, max channel of its weight) and the weight is divided by q.
 /// Self-hits: a ray ignores hits nearer than 1e-7 of the scene's diagonal to its origin (and to
-/// its end, for shadow rays), and hits on its own surface within that surface's chord error
-/// (curved surfaces, non-planar quads; see path_tracer.cpp). A start point within 1e-4 of the
+/// its end, for shadow rays). Vertices lie on the true surfaces, rays meet their facets: on a
+/// surface its facets miss (curved kinds, non-planar quads) rays leave from, and shadow rays
+/// aim at, the point moved along the normal by twice its chord error (see path_tracer.cpp);
+/// the estimate then carries an error of the order of that chord error (0.2-0.6 % on closed
+/// curved enclosures at tessellation 16, 0.1 % at 64). A start point within 1e-4 of the
 /// diagonal of its surface's edge is moved inward to that distance.
 /// Paths are independent of scheduling: each draws from its own counter-based generator seeded
 /// by (seed, point index, path index), and sums are formed in a fixed order, so the results are
