@@ -28,10 +28,18 @@ ConvexPolygon clip(const ConvexPolygon& polygon, const HalfPlane& h) {
         const Vec2 a = polygon[i], b = polygon[(i + 1) % n];
         const double va = h.value(a), vb = h.value(b);
         if (va >= 0) out.push_back(a);
-        // The edge crosses the line strictly: add the crossing point.
-        if ((va >= 0) != (vb >= 0) && va != vb) out.push_back(a + (va / (va - vb)) * (b - a));
+        // The edge crosses the line strictly (an end on the line is kept as a vertex already,
+        // or is the next edge's start): add the crossing point.
+        if ((va > 0 && vb < 0) || (va < 0 && vb > 0)) out.push_back(a + (va / (va - vb)) * (b - a));
     }
-    if (out.size() < 3) out.clear();
+    // Vertices on the line can still meet at one point (a polygon touching the line): drop
+    // repeated consecutive vertices, so every edge has a length.
+    size_t k = 0;
+    for (size_t i = 0; i < out.size(); ++i)
+        if (k == 0 || out[i].x != out[k - 1].x || out[i].y != out[k - 1].y) out[k++] = out[i];
+    while (k > 1 && out[k - 1].x == out[0].x && out[k - 1].y == out[0].y) --k;
+    out.resize(k);
+    if (out.size() < 3 || signed_area(out) <= 0) out.clear();
     return out;
 }
 

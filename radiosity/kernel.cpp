@@ -253,6 +253,9 @@ IncrementIntegrator::Result IncrementIntegrator::integrate(const SurfacePoint& p
     opt.n = options_.n;
     opt.tolerance = std::max(options_.rel_tolerance * scale, options_.abs_tolerance);
     opt.max_depth = options_.max_depth;
+    // Per-node visibility on a curved shooter: a visibility step never passes the n against
+    // n + 1 test, so without this cap its cells would split down to max_depth.
+    if (occlusion_ && !planar_) opt.max_depth = std::min(opt.max_depth, options_.max_visibility_depth);
     opt.min_depth = min_depth >= 0 ? std::min(min_depth, options_.max_depth) : options_.min_depth;
     opt.min_share = options_.min_share;
     opt.global = options_.global;

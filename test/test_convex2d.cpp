@@ -114,16 +114,14 @@ TEST_CASE("convex2d: clip by a half-plane against hand-computed polygons", "[con
 }
 
 TEST_CASE("convex2d: clip by a line through vertices repeats no vertex and leaves no sliver",
-          "[convex2d][!mayfail]") {
-    // BUG (math/convex2d.cpp, clip): the crossing point is added when an edge goes between a
-    // vertex ON the line (value 0) and one outside, although the comment says "crosses the line
-    // strictly"; that vertex is then pushed twice (a zero-length edge). Inputs and outputs:
-    // - unit square, x + y >= 1 (the line through (1,0) and (0,1)): expected the triangle
-    //   (1,0) (1,1) (0,1); got (1,0) (1,0) (1,1) (0,1) (0,1), right area, two repeated vertices;
-    // - unit square, x <= 0 (the line through its left edge): expected empty (no area on that
-    //   side); got the degenerate (0,0) (0,0) (0,1) (0,1) of area 0;
-    // - unit square, x + y <= 0 (touching the vertex (0,0) only): expected empty; got
-    //   (0,0) (0,0) (0,0). The header promises "fewer than three vertices left means empty".
+          "[convex2d]") {
+    // A vertex ON the line (value 0) followed by one outside must not add a crossing point (it
+    // would repeat the vertex: a zero-length edge). Found by this test, since fixed:
+    // - unit square, x + y >= 1 (the line through (1,0) and (0,1)): the triangle
+    //   (1,0) (1,1) (0,1) (it was (1,0) (1,0) (1,1) (0,1) (0,1));
+    // - unit square, x <= 0 (the line through its left edge): empty (it was (0,0) (0,0) (0,1)
+    //   (0,1) of area 0);
+    // - unit square, x + y <= 0 (touching the vertex (0,0) only): empty (it was (0,0) x 3).
     // Repeated vertices break classify and subtract (the zero-length-edge test below).
     const ConvexPolygon half = clip(unit_square, HalfPlane{{1, 1}, -1});
     CAPTURE(half);
@@ -167,13 +165,11 @@ TEST_CASE("convex2d: intersect against hand-computed polygons", "[convex2d]") {
     CHECK(signed_area(i) == Approx(2 * (std::sqrt(2.0) - 1)).epsilon(1e-14));
 }
 
-TEST_CASE("convex2d: intersections have no repeated vertices", "[convex2d][!mayfail]") {
-    // BUG (the clip bug above, seen through intersect): a vertex of `a` lying exactly on an edge
-    // line of `b` followed by a vertex outside it gives a repeated vertex. Input: a =
-    // (0.5,0) (0.8,-0.5) (1.2,0.6) (0.3,0.7), b = the unit square; expected: the hexagon
-    // (0.5,0) (0.981818,0) (1,0.05) (1,0.622222) (0.3,0.7) ... without repeats; got (0.5,0)
-    // twice (a zero-length edge). The area is right (0.392323), but the zero-length edge breaks
-    // classify and subtract (next test).
+TEST_CASE("convex2d: intersections have no repeated vertices", "[convex2d]") {
+    // The clip case above seen through intersect: a vertex of `a` lying exactly on an edge line
+    // of `b` followed by a vertex outside it. Input: a = (0.5,0) (0.8,-0.5) (1.2,0.6)
+    // (0.3,0.7), b = the unit square; expected: the hexagon (0.5,0) (0.981818,0) (1,0.05)
+    // (1,0.622222) (0.3,0.7) ... without repeats (before the fix, (0.5,0) came twice).
     const ConvexPolygon a{{0.5, 0}, {0.8, -0.5}, {1.2, 0.6}, {0.3, 0.7}};
     const ConvexPolygon i = intersect(a, unit_square);
     CAPTURE(i);
@@ -181,18 +177,14 @@ TEST_CASE("convex2d: intersections have no repeated vertices", "[convex2d][!mayf
     CHECK(repeated_vertices(i) == 0);
 }
 
-TEST_CASE("convex2d: subtract and classify survive a zero-length edge", "[convex2d][!mayfail]") {
-    // BUG (math/convex2d.cpp, subtract and classify): an edge of b of zero length gives
-    // left_of(b[i], b[i]) = the zero half-plane, whose value is 0 everywhere. classify then
-    // takes it for a separating axis (max over the other polygon <= 0) and answers disjoint;
-    // subtract clips `rest` by its "outside" (value 0 >= 0 everywhere), keeps ALL of rest as a
-    // piece, and carries on. Such polygons come out of intersect (test above), which is how
-    // blocked_view makes its shadows (radiosity/shadow.cpp); the consequence is measured in
-    // test_shadow.cpp ("shadow: exact visibility with a shadow vertex on the shooter's edge
-    // line"). Input: s = intersect(a, unit square) with a as above (area 0.392323, (0.5,0)
-    // twice). Expected: classify(s, square) = inside, classify(square, s) = partial,
-    // subtract(square, s) of total area 1 - 0.392323 = 0.607677. Got: disjoint, disjoint, and
-    // pieces of total area 1.60768 (the first piece is the whole square).
+TEST_CASE("convex2d: subtract and classify survive a zero-length edge", "[convex2d]") {
+    // An edge of b of zero length would give left_of(b[i], b[i]) = the zero half-plane (value 0
+    // everywhere): classify took it for a separating axis and answered disjoint, subtract kept
+    // all of `rest` as a piece. Such polygons came out of intersect (test above), which is how
+    // blocked_view makes its shadows (radiosity/shadow.cpp). Input: s = intersect(a, unit
+    // square) with a as above. Expected: classify(s, square) = inside, classify(square, s) =
+    // partial, subtract(square, s) of total area 1 - 0.392323 = 0.607677 (before the fix:
+    // disjoint, disjoint, and 1.60768).
     const ConvexPolygon a{{0.5, 0}, {0.8, -0.5}, {1.2, 0.6}, {0.3, 0.7}};
     const ConvexPolygon s = intersect(a, unit_square);
     CAPTURE(s);

@@ -355,8 +355,10 @@ TEST_CASE("kernel: adaptive quadrature of (21) matches the analytic form factor"
     // comparison with n = 6 over-estimates the error of the kept (n+1)-point value by orders of
     // magnitude, so the result is far better than the tolerance. Points include the receiver's
     // edges and, for the perpendicular squares, points very close to the common edge where the
-    // kernel is nearly singular.
-    const QuadratureOptions options;
+    // kernel is nearly singular. (The quadrature itself: not the closed form a constant planar
+    // shooter gets by default, which "kernel: the closed form for constant shooters" checks.)
+    QuadratureOptions options;
+    options.analytic = false;
     struct Config {
         const char* name;
         TransferSetup setup;
@@ -408,7 +410,9 @@ TEST_CASE("kernel: integrate_on its own partition gives integrate's value", "[ke
     // adaptive run summed in another order, so equal to rounding.
     const TransferSetup setup = perpendicular_squares();
     const Shooter shooter = unit_shooter(setup.shooter);
-    IncrementIntegrator integrator(shooter, QuadratureOptions{});
+    QuadratureOptions quadrature;
+    quadrature.analytic = false;  // the quadrature's own sum, not the closed form
+    IncrementIntegrator integrator(shooter, quadrature);
     std::mt19937 rng(7);
     std::uniform_real_distribution<double> unit(0.001, 1);
     for (int trial = 0; trial < 20; ++trial) {
@@ -472,10 +476,47 @@ TEST_CASE("kernel: quadrature of (21) weights the shooter's radiosity and area f
     // same cells are accepted and every product is scaled by a power of two.
     Shooter one = unit_shooter(quad), two = unit_shooter(quad);
     two.unshot = SplineField::constant(4, 0, {2, 2, 2});
-    IncrementIntegrator i1(one, QuadratureOptions{}), i2(two, QuadratureOptions{});
+    QuadratureOptions quadrature;
+    quadrature.analytic = false;  // the same cells of the quadrature, not the closed form
+    IncrementIntegrator i1(one, quadrature), i2(two, quadrature);
     const SurfacePoint p{{0.1, -0.2, 0}, {0, 0, 1}, 1};
     const double F = point_polygon_form_factor(p.position, p.normal, polygon);
     const Rgb v1 = i1.integrate(p).value, v2 = i2.integrate(p).value;
     CHECK(v2.r == 2 * v1.r);
     CHECK(v1.r == Approx(F).epsilon(1e-5));
+}
+
+TEST_CASE("kernel: the closed form for constant shooters", "[kernel]") {
+    // A planar quad shooter of constant radiosity: integrate() uses the contour formula over
+    // the visible part (QuadratureOptions::analytic). It must equal the analytic reference
+    // point_polygon_form_factor to rounding (1e-12), also where the receiver's tangent plane
+    // cuts the shooter (the reference clips there too), and the quadrature at a tight
+    // tolerance to that tolerance. It reports no kernel evaluations.
+    const double c = std::cos(Pi / 3), s = std::sin(Pi / 3);
+    const Surface shooters[] = {
+        parallel_squares(0.3).shooter,
+        Surface::planar_quad({0, 0, -0.5}, {0, 0, 1}, {1, 0, 1}, {1, 0, -0.5}),  // cut by z = 0
+        Surface::planar_quad({0, 0.2, 0.1}, {1, 0.2, 0.1}, {1, 0.2 + c, 0.1 + s}, {0, 0.2 + c, 0.1 + s})};
+    const Surface receiver = parallel_squares(1).receiver;
+    std::mt19937 rng(31);
+    std::uniform_real_distribution<double> unit(0.01, 0.99);
+    for (const Surface& quad : shooters) {
+        const Shooter shooter = unit_shooter(quad);
+        QuadratureOptions closed, tight;
+        tight.analytic = false;
+        tight.rel_tolerance = 1e-9;
+        IncrementIntegrator a(shooter, closed), q(shooter, tight);
+        REQUIRE(a.analytic());
+        const std::vector<Vec3> polygon{quad.corners()[0], quad.corners()[1], quad.corners()[2],
+                                        quad.corners()[3]};
+        for (int i = 0; i < 12; ++i) {
+            const SurfacePoint p = receiver.evaluate(unit(rng), unit(rng));
+            const double F = point_polygon_form_factor(p.position, p.normal, polygon);
+            const IncrementIntegrator::Result r = a.integrate(p);
+            CAPTURE(p.position, F, r.value.r);
+            CHECK(r.n_evaluations == 0);
+            CHECK(std::fabs(r.value.r - F) <= 1e-12 * std::max(F, 1e-3));
+            CHECK(std::fabs(q.integrate(p).value.r - F) <= 1e-8 * std::max(F, 1e-3));
+        }
+    }
 }
