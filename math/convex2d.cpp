@@ -71,6 +71,40 @@ std::vector<ConvexPolygon> subtract(const ConvexPolygon& a, const ConvexPolygon&
     return pieces;
 }
 
+ConvexPolygon convex_hull(std::vector<Vec2> points) {
+    std::sort(points.begin(), points.end(),
+              [](Vec2 a, Vec2 b) { return a.x != b.x ? a.x < b.x : a.y < b.y; });
+    points.erase(std::unique(points.begin(), points.end(),
+                             [](Vec2 a, Vec2 b) { return a.x == b.x && a.y == b.y; }),
+                 points.end());
+    if (points.size() < 3) return {};
+    ConvexPolygon hull(2 * points.size());
+    size_t k = 0;
+    for (size_t i = 0; i < points.size(); ++i) {  // lower hull
+        while (k >= 2 && cross(hull[k - 1] - hull[k - 2], points[i] - hull[k - 2]) <= 0) --k;
+        hull[k++] = points[i];
+    }
+    for (size_t i = points.size() - 1, t = k + 1; i-- > 0;) {  // upper hull
+        while (k >= t && cross(hull[k - 1] - hull[k - 2], points[i] - hull[k - 2]) <= 0) --k;
+        hull[k++] = points[i];
+    }
+    hull.resize(k - 1);
+    if (hull.size() < 3) hull.clear();
+    return hull;
+}
+
+ConvexPolygon convex_union(const ConvexPolygon& a, const ConvexPolygon& b, double rel_tolerance) {
+    std::vector<Vec2> points(a.begin(), a.end());
+    points.insert(points.end(), b.begin(), b.end());
+    ConvexPolygon hull = convex_hull(points);
+    if (hull.empty()) return hull;
+    const ConvexPolygon common = intersect(a, b);
+    const double covered = signed_area(a) + signed_area(b) - (common.empty() ? 0.0 : signed_area(common));
+    const double area = signed_area(hull);
+    if (area - covered > rel_tolerance * area) hull.clear();  // the hull holds more: not convex
+    return hull;
+}
+
 Overlap classify(const ConvexPolygon& a, const ConvexPolygon& b) {
     if (a.size() < 3 || b.size() < 3) return Overlap::disjoint;
     // Separating axis: an edge line of either polygon with the other wholly outside it.

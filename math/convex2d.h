@@ -41,6 +41,14 @@ ConvexPolygon intersect(const ConvexPolygon& a, const ConvexPolygon& b);
 std::vector<ConvexPolygon> subtract(const ConvexPolygon& a, const ConvexPolygon& b,
                                     double min_area = 0);
 
+/// The convex hull of points, counter-clockwise (Andrew's monotone chain); collinear points on
+/// its edges are dropped.
+ConvexPolygon convex_hull(std::vector<Vec2> points);
+
+/// The union of two convex polygons when it is convex (the hull's area equals area(a) +
+/// area(b) - area(a and b) within rel_tolerance of the hull's area), else an empty polygon.
+ConvexPolygon convex_union(const ConvexPolygon& a, const ConvexPolygon& b, double rel_tolerance = 1e-9);
+
 /// How a convex polygon lies relative to another: disjoint (at most touching), inside it
 /// (within `slack` of its edges), or overlapping.
 enum class Overlap { disjoint, inside, partial };

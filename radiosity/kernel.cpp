@@ -78,10 +78,15 @@ IncrementIntegrator::IncrementIntegrator(const Shooter& shooter, const Quadratur
 
 Rgb IncrementIntegrator::analytic_value(const SurfacePoint& p) {
     // Eq. (21) for a constant B_h over a planar polygon: B_h times the form factor from p to
-    // the part of the shooter p sees, by the contour formula of the reference (Baum et al.
-    // 1989), piece by piece (each convex, counter-clockwise seen from the shooter's front).
+    // the part of the shooter p sees.
     set_view(p);
-    if (view_.behind_all) return Rgb{};
+    return visible_form_factor(p) * shooter_.unshot.coefficient(0, 0);
+}
+
+double IncrementIntegrator::visible_form_factor(const SurfacePoint& p) {
+    // The contour formula of the reference (Baum et al. 1989), piece by piece (each convex,
+    // counter-clockwise seen from the shooter's front).
+    if (view_.behind_all) return 0;
     std::vector<ConvexPolygon> pieces;
     if (view_.trivial())
         pieces.push_back(plane_.outline);
@@ -94,7 +99,7 @@ Rgb IncrementIntegrator::analytic_value(const SurfacePoint& p) {
         for (const Vec2& q : piece) polygon.push_back(plane_.to_space(q));
         F += point_polygon_form_factor(p.position, p.normal, polygon);
     }
-    return F * shooter_.unshot.coefficient(0, 0);
+    return F;
 }
 
 IncrementIntegrator::PointSpan IncrementIntegrator::points(const QuadCell& cell, int n) {
@@ -130,7 +135,7 @@ IncrementIntegrator::PointSpan IncrementIntegrator::points(const QuadCell& cell,
         for (int b = 0; b < n; ++b) {
             const SurfacePoint sp = shooter_.surface->evaluate(u[a], v[b]);
             const double w_J_A = rule.w[a] * rule.w[b] * hx * hy * sp.area_factor;
-            pool_.push_back({sp.position, sp.normal, w_J_A * B[a * n + b]});
+            pool_.push_back({sp.position, sp.normal, w_J_A * B[a * n + b], w_J_A});
         }
     cache_.emplace(key, offset);
     return {pool_.data() + offset, n * n};
@@ -141,12 +146,13 @@ Rgb IncrementIntegrator::sum_over(const SurfacePoint& p, PointSpan pts) const {
     for (int i = 0; i < pts.count; ++i) {
         const ShooterPoint& q = pts.first[i];
         const double F = form_factor_kernel(p.position, p.normal, q.x, q.n);  // eq. (3)
-        if (F != 0) sum += F * q.e;
+        if (F != 0) sum += F * (q.e - q.a * b_star_);  // b_star_ is zero unless subtracting
     }
     return sum;
 }
 
 void IncrementIntegrator::set_view(const SurfacePoint& p) {
+    b_star_ = Rgb{};
     extra_evaluations_ = 0;
     rays_ = 0;
     mixed_.clear();
@@ -191,7 +197,7 @@ Rgb IncrementIntegrator::pieces_value(const SurfacePoint& p, const std::vector<C
                     const Vec2 uv = plane_.parameters(X);
                     B = shooter_.unshot.evaluate(std::clamp(uv.x, 0.0, 1.0), std::clamp(uv.y, 0.0, 1.0));
                 }
-                sum += (rule.weights[q] * jacobian * F) * B;
+                sum += (rule.weights[q] * jacobian * F) * (B - b_star_);
             }
         }
     return sum;
@@ -205,6 +211,10 @@ Rgb IncrementIntegrator::cell_value(const SurfacePoint& p, const QuadCell& cell,
             case CellVisibility::clear: return sum_over(p, points(cell, n));
             case CellVisibility::cut: {
                 const std::uint64_t key = cell_key(cell);
+                if (cell.level < options_.min_cut_level && cell.level < options_.max_depth) {
+                    mixed_.push_back(key);  // split without integrating its pieces
+                    return Rgb{};
+                }
                 if (key != pieces_key_) {  // the n and n+1 rules of one cell share the pieces
                     pieces_ = visible_pieces(image, view_);
                     pieces_key_ = key;
@@ -234,7 +244,8 @@ Rgb IncrementIntegrator::cell_value(const SurfacePoint& p, const QuadCell& cell,
 }
 
 IncrementIntegrator::Result IncrementIntegrator::integrate(const SurfacePoint& p,
-                                                           bool keep_partition, int min_depth) {
+                                                           bool keep_partition, int min_depth,
+                                                           bool allow_subtraction) {
     Result result;
     if (analytic_ && !keep_partition) {
         result.value = analytic_value(p);
@@ -249,6 +260,18 @@ IncrementIntegrator::Result IncrementIntegrator::integrate(const SurfacePoint& p
     const QuadCell root{0, 0, 0, Rect{0, 1, 0, 1}};
     const double estimate = max_abs(sum_over(p, points(root, options_.n + 1)));
     const double scale = std::max(estimate, 1e-4 * unshot_bound_);
+    // Singularity subtraction (QuadratureOptions::subtract): the constant B_h(x*) at the foot
+    // x* of p carries the peak of F exactly; the rule integrates F (B_h - B_h(x*)).
+    double near_field = options_.near_field;
+    Rgb exact_part;
+    if (planar_ && !unshot_constant_ && options_.subtract && allow_subtraction) {
+        const Vec2 uv = plane_.parameters(plane_.to_plane(p.position));
+        const Rgb b_star = shooter_.unshot.evaluate(std::clamp(uv.x, 0.0, 1.0), std::clamp(uv.y, 0.0, 1.0));
+        exact_part = visible_form_factor(p) * b_star;
+        b_star_ = b_star;
+        result.subtracted = b_star;
+        near_field = options_.near_field_subtracted;
+    }
     AdaptiveOptions opt;
     opt.n = options_.n;
     opt.tolerance = std::max(options_.rel_tolerance * scale, options_.abs_tolerance);
@@ -268,18 +291,23 @@ IncrementIntegrator::Result IncrementIntegrator::integrate(const SurfacePoint& p
     // the shooter sees. A cell is trusted only when it is well separated from p: its points'
     // extent at most near_field times their distance from p.
     auto near = [&](const QuadCell& cell) {
-        if (occlusion_ && !planar_ && cell.level < options_.max_visibility_depth &&
-            std::find(mixed_.begin(), mixed_.end(), cell_key(cell)) != mixed_.end())
-            return true;  // its nodes disagree on visibility: split
-        if (options_.near_field <= 0) return false;
+        if (!mixed_.empty() && std::find(mixed_.begin(), mixed_.end(), cell_key(cell)) != mixed_.end() &&
+            (planar_ || cell.level < options_.max_visibility_depth))
+            return true;  // its nodes disagree on visibility, or a coarse cut cell: split
+        if (near_field <= 0) return false;
+        // The cell's extent: its nodes and its corners (the nodes alone leave a gap along the
+        // cell's edges, where a peak between two cells would escape both).
         const PointSpan pts = points(cell, options_.n + 1);
         Box3 box;
         for (int i = 0; i < pts.count; ++i) box.extend(pts.first[i].x);
+        const Rect& r = cell.rect;
+        for (const Vec2 c : {Vec2{r.x0, r.y0}, Vec2{r.x1, r.y0}, Vec2{r.x0, r.y1}, Vec2{r.x1, r.y1}})
+            box.extend(shooter_.surface->point(c.x, c.y));
         const Vec3 gap = max(max(box.lo - p.position, p.position - box.hi), Vec3{0, 0, 0});
-        return length(box.extent()) > options_.near_field * length(gap);
+        return length(box.extent()) > near_field * length(gap);
     };
     auto r = adaptive_tensor_rule_2d(cell_rule, root.rect, opt, keep_partition, near);
-    result.value = r.value;
+    result.value = r.value + exact_part;
     result.n_evaluations = r.n_evaluations + long(options_.n + 1) * (options_.n + 1) + extra_evaluations_;
     result.n_rays = rays_;
     result.converged = r.converged;
@@ -289,9 +317,13 @@ IncrementIntegrator::Result IncrementIntegrator::integrate(const SurfacePoint& p
 
 Rgb IncrementIntegrator::integrate_on(const SurfacePoint& p,
                                       const std::vector<AcceptedCell<Rgb>>& partition,
-                                      long* n_evaluations, long* n_rays) {
+                                      long* n_evaluations, long* n_rays, const Result* made_by) {
     set_view(p);
     Rgb sum;
+    if (made_by && max_abs(made_by->subtracted) > 0) {  // the same constant subtracted
+        b_star_ = made_by->subtracted;
+        sum = visible_form_factor(p) * b_star_;
+    }
     if (!view_.behind_all)
         for (const auto& c : partition) sum += cell_value(p, c.cell, options_.n + 1);
     if (n_evaluations)

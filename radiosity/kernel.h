@@ -60,6 +60,18 @@ struct QuadratureOptions {
                                   //   first shot): I(p) by the contour formula over the
                                   //   visible pieces, no quadrature (not when a partition is
                                   //   asked for)
+    int min_cut_level = 3;        // a cell the horizon or a shadow cuts is split down to this
+                                  //   level before its visible pieces are integrated (pieces
+                                  //   of big cells are many and costly, and their error
+                                  //   would split them anyway)
+    bool subtract = true;         // planar quad shooters of varying radiosity: I(p) =
+                                  //   B_h(x*) F(p -> visible part) + int F (B_h - B_h(x*)),
+                                  //   the first term by the contour formula (x* the foot of p
+                                  //   on the shooter), so the peak of F near a receiving point
+                                  //   close to the shooter (surfaces that meet) is exact and the
+                                  //   remainder is nearly flat there
+    double near_field_subtracted = 0;  // the near-field guard when subtracting (0: off: the
+                                  //   remainder has no peak a cell's nodes could miss)
     bool clip_horizon = true;     // planar shooters: integrate cells the receiving point's
                                   //   tangent plane cuts over their front part only (exact
                                   //   convex pieces), instead of chasing the kink of the
@@ -75,6 +87,7 @@ struct ShooterPoint {
     Vec3 x;
     Vec3 n;
     Rgb e;
+    double a = 0;  // w_a w_b J A_h(u,v): e without B_h (for the singularity subtraction)
 };
 
 /// The integral of eq. (21) without the receiver's reflectance:
@@ -94,18 +107,22 @@ public:
         Rgb value;
         long n_evaluations = 0;   // kernel evaluations
         long n_rays = 0;          // visibility rays (exact visibility on a curved shooter)
+        Rgb subtracted;           // B_h(x*) when the singularity was subtracted (the partition's
+                                  //   cell values are then those of the remainder)
         bool converged = true;
         std::vector<AcceptedCell<Rgb>> partition;  // the shooter's cells, when asked for
     };
     /// I(p) by the adaptive rule; the shooter partition is kept when keep_partition is set
     /// (the shadow stage casts rays to its cells; edgefill reuses it for divided differences).
     /// min_depth >= 0 overrides the options' smallest depth of the partition.
-    Result integrate(const SurfacePoint& p, bool keep_partition = false, int min_depth = -1);
+    Result integrate(const SurfacePoint& p, bool keep_partition = false, int min_depth = -1,
+                     bool allow_subtraction = true);
     /// I(p) on a given partition with the (n+1)-point rule on each cell: the same quadrature
     /// error pattern as the run that made the partition, so divided differences (22) of nearby
-    /// points are not swamped by it.
+    /// points are not swamped by it. `made_by`, the result that made the partition, says
+    /// whether (and what) it subtracted: the same constant is subtracted here.
     Rgb integrate_on(const SurfacePoint& p, const std::vector<AcceptedCell<Rgb>>& partition,
-                     long* n_evaluations, long* n_rays = nullptr);
+                     long* n_evaluations, long* n_rays = nullptr, const Result* made_by = nullptr);
     /// The points of a cell for the n-point rule (cached): n*n points from `first`, valid until
     /// the next call.
     struct PointSpan {
@@ -118,6 +135,8 @@ public:
 
 private:
     Rgb sum_over(const SurfacePoint& p, PointSpan pts) const;
+    /// The visible part's form factor from p by the contour formula (after set_view).
+    double visible_form_factor(const SurfacePoint& p);
     /// The n x n rule on one cell as p sees it (the view of the last set_view): cached points
     /// for a clear cell, zero for a hidden one, convex pieces for a cut one; per-node rays on
     /// a curved shooter with an occlusion context.
@@ -137,7 +156,9 @@ private:
     std::vector<TriangleRule> tri_rules_;  // tri_rules_[n]
     long extra_evaluations_ = 0;        // kernel evaluations on cut pieces (current point)
     long rays_ = 0;                     // rays cast for the current point
-    std::vector<std::uint64_t> mixed_;  // cells whose nodes disagreed on visibility (curved)
+    Rgb b_star_;                        // the constant subtracted from B_h (zero: none)
+    std::vector<std::uint64_t> mixed_;  // cells whose nodes disagreed on visibility (curved), or
+                                        //   cut cells above min_cut_level (planar): split
     std::uint64_t pieces_key_ = ~0ULL;  // the cut cell whose pieces are in pieces_
     std::vector<ConvexPolygon> pieces_;
     std::vector<GaussLegendre> rules_;  // rules_[n]

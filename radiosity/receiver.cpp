@@ -118,7 +118,7 @@ void IncrementSampler::sample_pair(double s, double t, double ds, double dt, int
     const SurfacePoint q = receiver_.surface->evaluate(s + ds, t + dt);
     long evals = r.n_evaluations;
     rays_[thread] += r.n_rays;
-    const Rgb value_q = integrator.integrate_on(q, r.partition, &evals, &rays_[thread]);
+    const Rgb value_q = integrator.integrate_on(q, r.partition, &evals, &rays_[thread], &r);
     if (n_kernel_evals) *n_kernel_evals += evals;
     at_p = receiver_.reflectance(s, t) * r.value;
     at_q = receiver_.reflectance(s + ds, t + dt) * value_q;

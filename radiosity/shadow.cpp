@@ -256,7 +256,31 @@ BlockedView blocked_view(const ShooterPlane& plane, Vec3 p, Vec3 n_p,
         shadow = intersect(shadow, plane.outline);
         if (!shadow.empty()) view.shadows.push_back(std::move(shadow));
     }
+    merge_shadows(view.shadows);
     return view;
+}
+
+void merge_shadows(std::vector<ConvexPolygon>& shadows) {
+    // The faces of one solid cast overlapping shadows (a box's top and sides); every cell a
+    // shadow edge cuts is integrated over convex pieces, and each overlapping shadow multiplies
+    // the pieces. Two shadows whose union is convex (one inside the other, or overlapping or
+    // touching so that no notch is left) become that
+    // union, until no pair merges (the faces of a convex solid usually end as one polygon,
+    // its silhouette's).
+    // DESIGN: the convexity test's tolerance, 1e-9 of the hull's area, only absorbs rounding.
+    for (bool merged = true; merged;) {
+        merged = false;
+        for (size_t i = 0; i < shadows.size() && !merged; ++i)
+            for (size_t j = i + 1; j < shadows.size() && !merged; ++j) {
+                // Overlapping, nested or only touching along an edge (two faces of one solid):
+                // the hull is the union exactly when the union is convex.
+                ConvexPolygon u = convex_union(shadows[i], shadows[j]);
+                if (u.empty()) continue;
+                shadows[i] = std::move(u);
+                shadows.erase(shadows.begin() + long(j));
+                merged = true;
+            }
+    }
 }
 
 CellVisibility classify_cell(const ConvexPolygon& cell, const BlockedView& view) {

@@ -105,6 +105,9 @@ struct BlockedView {
 BlockedView blocked_view(const ShooterPlane& plane, Vec3 p, Vec3 n_p,
                          const OcclusionContext* context);
 
+/// Drops shadows inside another and merges pairs whose union is convex, until none merges.
+void merge_shadows(std::vector<ConvexPolygon>& shadows);
+
 /// How a shooter cell (its image, a convex quad of the plane) lies in a view.
 enum class CellVisibility { clear, hidden, cut };
 CellVisibility classify_cell(const ConvexPolygon& cell, const BlockedView& view);

@@ -40,7 +40,7 @@ Rgb compute_fraction(const ReceiverState& state, IncrementSampler& sampler, Vec2
                  t = std::clamp(point.y, inset, 1 - inset);
     const SurfacePoint p = sampler.receiver().surface->evaluate(s, t);
     const IncrementIntegrator::Result r =
-        sampler.integrator(thread).integrate(p, true, state.options.shadows.min_patch_depth);
+        sampler.integrator(thread).integrate(p, true, state.options.shadows.min_patch_depth, false);
     *n_evals += r.n_evaluations;
     const int n_rays_per_patch = state.options.shadows.rays_per_patch;
     const Surface& shooter = *sampler.shooter().surface;

@@ -82,6 +82,10 @@ std::uint64_t cell_key(const DyadicCell& c) {
 
 SolverOptions solver_options(const SolverSettings& s) {
     SolverOptions o;
+    // DESIGN: in a scene every shooter partition refines its worst cell first (the sum of the
+    // error estimates is bounded as the paper's rule bounds it, with far fewer cells on spline
+    // shooters); see docs/method.md.
+    o.receiver.quadrature.global = true;
     o.receiver.m = s.order;
     o.receiver.min_depth = s.min_depth;
     o.receiver.max_depth = s.max_depth;
