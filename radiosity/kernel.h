@@ -60,10 +60,10 @@ struct QuadratureOptions {
                                   //   first shot): I(p) by the contour formula over the
                                   //   visible pieces, no quadrature (not when a partition is
                                   //   asked for)
-    int min_cut_level = 3;        // a cell the horizon or a shadow cuts is split down to this
-                                  //   level before its visible pieces are integrated (pieces
-                                  //   of big cells are many and costly, and their error
-                                  //   would split them anyway)
+    int min_cut_level = 1;        // a cell the horizon or a shadow cuts is split down to this
+                                  //   level before its visible pieces are integrated (the
+                                  //   root's pieces would be many; deeper cells are split by
+                                  //   the error test when their pieces disagree)
     bool subtract = true;         // planar quad shooters of varying radiosity: I(p) =
                                   //   B_h(x*) F(p -> visible part) + int F (B_h - B_h(x*)),
                                   //   the first term by the contour formula (x* the foot of p

@@ -95,8 +95,10 @@ long IncrementSampler::n_rays() const {
 
 Rgb IncrementSampler::sample(double s, double t, int thread, long* n_kernel_evals,
                              bool* converged) {
-    // Eq. (21): dB_i(s,t) = rho_i(s,t) * int int F VIS B_h A_h du dv.
-    const SurfacePoint p = receiver_.surface->evaluate(s, t);
+    // Eq. (21): dB_i(s,t) = rho_i(s,t) * int int F VIS B_h A_h du dv (at the nearest visible
+    // point when (s, t) is hidden: radiosity/hidden.h).
+    const Vec2 at = receiver_.hidden ? receiver_.hidden->substitute(s, t) : Vec2{s, t};
+    const SurfacePoint p = receiver_.surface->evaluate(at.x, at.y);
     const IncrementIntegrator::Result r = integrators_[thread]->integrate(p);
     if (n_kernel_evals) *n_kernel_evals += r.n_evaluations;
     rays_[thread] += r.n_rays;
@@ -107,6 +109,10 @@ Rgb IncrementSampler::sample(double s, double t, int thread, long* n_kernel_eval
 void IncrementSampler::sample_pair(double s, double t, double ds, double dt, int thread,
                                    Rgb& at_p, Rgb& at_q, long* n_kernel_evals) {
     IncrementIntegrator& integrator = *integrators_[thread];
+    if (receiver_.hidden && receiver_.hidden->hidden(s, t)) {  // constant extension: no slope
+        at_p = at_q = sample(s, t, thread, n_kernel_evals);
+        return;
+    }
     const SurfacePoint p = receiver_.surface->evaluate(s, t);
     if (integrator.analytic()) {  // closed form at both points: no partition to share
         const SurfacePoint q = receiver_.surface->evaluate(s + ds, t + dt);
@@ -316,7 +322,13 @@ void sample_leaves(ReceiverState& state, IncrementSampler& sampler) {
         state.stats.n_increments += long(m) * m;
         state.stats.n_unconverged += unconverged[c];
         const Rgb* out = &state.samples[size_t(state.forest.node(todo[c]).samples) * m * m];
-        for (int i = 0; i < m * m; ++i) state.max_sample = std::max(state.max_sample, max_abs(out[i]));
+        for (int i = 0; i < m * m; ++i) {
+            state.max_sample = std::max(state.max_sample, max_abs(out[i]));
+            for (int k = 0; k < 3; ++k) {
+                state.sample_lo[k] = std::min(state.sample_lo[k], out[i][k]);
+                state.sample_hi[k] = std::max(state.sample_hi[k], out[i][k]);
+            }
+        }
     }
 }
 
@@ -469,6 +481,19 @@ void decay_profiles(Extrapolation kind, double x, double& phi0, double& phi1) {
 
 }  // namespace
 
+namespace {
+/// Linear extrapolation (23)-(25), each channel kept within the samples' range widened by its
+/// own width on both sides when clamp_values is set.
+Rgb clamp_to_samples(const ReceiverState& state, Rgb v) {
+    if (!state.options.clamp_values) return v;
+    for (int c = 0; c < 3; ++c) {
+        const double span = state.sample_hi[c] - state.sample_lo[c];
+        v[c] = std::clamp(v[c], state.sample_lo[c] - span, state.sample_hi[c] + span);
+    }
+    return v;
+}
+}  // namespace
+
 Rgb extrapolate(const ReceiverState& state, double s, double t) {
     const ReceiverOptions& opt = state.options;
     const int si = s < 0 ? -1 : (s > 1 ? 1 : 0);
@@ -490,7 +515,7 @@ Rgb extrapolate(const ReceiverState& state, double s, double t) {
         d = clamp_rgb(d, clamp_bound(p));
         // Signed offset from the edge along its normal coordinate (t - c or s - b).
         const double offset = e == 0 ? t : (e == 1 ? s - 1 : (e == 2 ? t - 1 : s));
-        if (linear) return v + offset * d;  // eq. (23)
+        if (linear) return clamp_to_samples(state, v + offset * d);  // eq. (23)
         const double w = p.h_min, x = std::fabs(offset) / w;
         const Rgb d_out = (offset < 0 ? -1.0 : 1.0) * d;  // derivative along the outward normal
         double phi0, phi1;
@@ -506,7 +531,7 @@ Rgb extrapolate(const ReceiverState& state, double s, double t) {
     vertical.at(t_c, v2, d_s);
     d_t = clamp_rgb(d_t, clamp_bound(horizontal));
     d_s = clamp_rgb(d_s, clamp_bound(vertical));
-    if (linear) return v + (s - s_c) * d_s + (t - t_c) * d_t;  // eqs. (24), (25)
+    if (linear) return clamp_to_samples(state, v + (s - s_c) * d_s + (t - t_c) * d_t);  // (24), (25)
     const double w_s = vertical.h_min, w_t = horizontal.h_min;
     double phi0_x, phi1_x, phi0_y, phi1_y;
     decay_profiles(opt.extrapolation, std::fabs(s - s_c) / w_s, phi0_x, phi1_x);

@@ -30,6 +30,7 @@
 #include <vector>
 
 #include "math/dual_basis.h"
+#include "radiosity/hidden.h"
 #include "radiosity/kernel.h"
 #include "radiosity/quadtree.h"
 #include "radiosity/shadow.h"
@@ -68,6 +69,11 @@ struct ReceiverOptions {
     double rhombus_radius = 0;         // in cells of the fulcrum's scale; 0: from truncation_eps
     Extrapolation extrapolation = Extrapolation::Linear;
     double clamp_factor = 1.0;         // |dB_n| <= clamp_factor * max|dB| / h_min per edge
+    bool clamp_values = true;          // DESIGN: extrapolated values also stay within the range
+                                       //   of the samples [lo, hi] (lo <= 0) widened by its width
+                                       //   on both sides: a steep edge (a surface meeting
+                                       //   another) would otherwise be continued to many times
+                                       //   max|dB| across the ring
     EdgefillTest edgefill_test = EdgefillTest::Linearity;  // DESIGN: the chord test; the
                                        //   paper's Variation test gives the same rea with ~3x
                                        //   the boundary samples (docs/method.md)
@@ -121,6 +127,8 @@ struct TransferStats {
 struct ReceiverSurface {
     const Surface* surface = nullptr;
     std::function<Rgb(double, double)> reflectance;
+    const HiddenMask* hidden = nullptr;  // may be null: a sample at a hidden point takes the
+                                         //   value of (21) at the nearest visible point
 };
 
 /// Boundary values and derivatives along one edge of [0,1]^2 (stage 3): nodes at edge
@@ -168,6 +176,7 @@ struct ReceiverState {
     Forest forest;                        // domain root (0,0) and, from stage 4, the ring
     std::vector<Rgb> samples;             // m*m values per sampled leaf (node.samples indexes)
     double max_sample = 0;                // largest |dB| seen in the domain (scale of tests)
+    Rgb sample_lo, sample_hi;             // per channel: the samples' range (lo <= 0 <= hi)
     std::array<EdgeProfile, 4> edges;     // bottom (t=0), right (s=1), top (t=1), left (s=0)
     std::vector<Fulcrum> fulcrums;        // stage 5
     std::map<Fulcrum, Rgb> coefficients;  // stage 6 (and on-demand ones from stage 8)

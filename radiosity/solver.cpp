@@ -86,6 +86,9 @@ SolverOptions solver_options(const SolverSettings& s) {
     // error estimates is bounded as the paper's rule bounds it, with far fewer cells on spline
     // shooters); see docs/method.md.
     o.receiver.quadrature.global = true;
+    // DESIGN: 4 against 5 points per cell: a scene's tolerances are absolute and coarse, where
+    // the lower pair needs half the kernel evaluations of 6 against 7 (docs/method.md).
+    o.receiver.quadrature.n = 4;
     o.receiver.m = s.order;
     o.receiver.min_depth = s.min_depth;
     o.receiver.max_depth = s.max_depth;
@@ -173,7 +176,11 @@ ProgressiveSolver::ProgressiveSolver(const Scene& scene, const Octree& octree,
     solution_.unshot.resize(n);
     solution_.leaves.resize(n);
     split_cells_.resize(n);
+    coupling_.resize(n);
     weights_.resize(n);
+    hidden_.resize(n);
+    if (options.hidden_regions)
+        for (int i = 0; i < n; ++i) hidden_[i] = find_hidden(scene.surfaces[i].surface, i, octree, options.hidden);
     // "for each emitting surface L_i compute the projection of its emittance distribution".
     double emitted = 0;
     Rgb emitted_rgb;
@@ -293,8 +300,9 @@ ShotStats ProgressiveSolver::shoot() {
     ReceiverOptions ro = options_.receiver;
     ro.absolute_tolerance = options_.tolerance * radiosity_scale_;
     ro.quadrature.abs_tolerance = options_.quadrature_share * ro.absolute_tolerance;
-    const Shooter shooter =
-        make_shooter(shooter_surface, solution_.unshot[h], ro.shooter_coarsening);
+    const SplineField& unshot_h = solution_.unshot[h];
+    const int coarsen = std::max(ro.shooter_coarsening, unshot_h.level() - options_.shooter_level);
+    const Shooter shooter = make_shooter(shooter_surface, unshot_h, coarsen);
 
     struct Received {
         SplineField field;
@@ -309,7 +317,8 @@ ShotStats ProgressiveSolver::shoot() {
         const int i = receivers[k];
         const Texture& rho = scene_.material_of(i).reflectance;
         const ReceiverSurface receiver{&scene_.surfaces[i].surface,
-                                       [&rho](double s, double t) { return rho.value(s, t); }};
+                                       [&rho](double s, double t) { return rho.value(s, t); },
+                                       hidden_[i].any() ? &hidden_[i] : nullptr};
         const OcclusionContext occlusion = make_occlusion_context(
             octree_, shooter_surface, h, scene_.surfaces[i].surface, i, std::uint64_t(shot.shot));
         ReceiverState state;
@@ -329,17 +338,22 @@ ShotStats ProgressiveSolver::shoot() {
     }
 
     // Superposition in receiver order: B_i += dB_i, B_unshot_i += dB_i; then B_unshot_h = 0.
+    const Rgb shot_power = power(h, shooter.unshot);
+    std::vector<Rgb>& row = coupling_[h];
+    row.assign(n, Rgb{});
     for (int k = 0; k < n_rec; ++k) {
         const int i = receivers[k];
         Received& r = results[k];
         const Rgb reflected = power(i, r.field);
         shot.reflected += channel_sum(reflected);
-        const Texture& rho = scene_.material_of(i).reflectance;
-        if (rho.is_constant()) {
-            const Rgb rv = rho.value(0.5, 0.5);
-            for (int c = 0; c < 3; ++c)
-                if (rv[c] > 0) shot.incident += reflected[c] / rv[c];
-        }
+        // Incident power: what was reflected over the reflectance (its mean for a texture).
+        const Rgb rv = scene_.material_of(i).reflectance.mean();
+        for (int c = 0; c < 3; ++c)
+            if (rv[c] > 0) {
+                const double incident = reflected[c] / rv[c];
+                shot.incident += incident;
+                if (shot_power[c] > 0) row[i][c] = incident / shot_power[c];
+            }
         solution_.radiosity[i].add(r.field);
         solution_.unshot[i].add(r.field);
         shot.kernel_evals += r.stats.n_kernel_evals;
@@ -370,9 +384,59 @@ ShotStats ProgressiveSolver::shoot() {
     return shot;
 }
 
+std::vector<Rgb> ProgressiveSolver::ambient_correction() const {
+    // The power still unshot, U_j, and what it will become: X_i = U_i + rho_i sum_j F_ji X_j,
+    // with F_ji the measured fraction of j's shot power that reaches i (a surface that never
+    // shot spreads in proportion to the other surfaces' areas). Solved by Jacobi iteration
+    // (it converges: rho < 1 and each row of F sums to at most one). What surface i gains,
+    // rho_i sum_j F_ji X_j, is spread over its area as a constant radiosity.
+    const int n = static_cast<int>(scene_.surfaces.size());
+    std::vector<Rgb> U(n), rho(n);
+    std::vector<double> area(n);
+    double total_area = 0;
+    for (int i = 0; i < n; ++i) {
+        U[i] = power(i, solution_.unshot[i]);
+        rho[i] = scene_.material_of(i).reflectance.mean();
+        area[i] = scene_.surfaces[i].surface.area();
+        total_area += area[i];
+    }
+    auto coupling = [&](int j, int i) -> Rgb {
+        if (!coupling_[j].empty()) return coupling_[j][i];
+        const double f = i == j ? 0.0 : area[i] / (total_area - area[j]);
+        return {f, f, f};
+    };
+    std::vector<Rgb> X = U, gain(n);
+    for (int iteration = 0; iteration < 1000; ++iteration) {
+        double change = 0, size = 0;
+        for (int i = 0; i < n; ++i) {
+            Rgb arriving;
+            for (int j = 0; j < n; ++j) arriving += coupling(j, i) * X[j];
+            gain[i] = rho[i] * arriving;
+        }
+        for (int i = 0; i < n; ++i) {
+            const Rgb next = U[i] + gain[i];
+            change += max_abs(next - X[i]);
+            size += max_abs(next);
+            X[i] = next;
+        }
+        if (change <= 1e-12 * size) break;
+    }
+    std::vector<Rgb> correction(n);
+    for (int i = 0; i < n; ++i) correction[i] = area[i] > 0 ? (1 / area[i]) * gain[i] : Rgb{};
+    return correction;
+}
+
 Solution ProgressiveSolver::finish() {
     Solution out = solution_;
     SolveStats& st = out.stats;
+    if (options_.ambient) {
+        const std::vector<Rgb> correction = ambient_correction();
+        for (size_t i = 0; i < correction.size(); ++i) {
+            if (max_abs(correction[i]) == 0) continue;
+            out.radiosity[i].add(SplineField::constant(options_.receiver.m, 0, correction[i]));
+            st.ambient_power += channel_sum(correction[i]) * scene_.surfaces[i].surface.area();
+        }
+    }
     st.seconds = now() - start_seconds_;
     st.peak_memory_bytes = peak_memory_bytes();
     double largest = 0;

@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "octree/octree.h"
+#include "radiosity/hidden.h"
 #include "radiosity/quadtree.h"
 #include "radiosity/receiver.h"
 #include "radiosity/scene.h"
@@ -38,6 +39,20 @@ struct SolverOptions {
                                     //   absolute tolerance of every transfer (see file comment)
     double quadrature_share = 0.1;  // the quadrature's absolute tolerance, as a share of it
     int emission_level = 5;         // level at which a textured emission is projected
+    bool hidden_regions = true;     // beyond the paper: samples at points that see no front
+                                    //   face take the nearest visible point's value
+                                    //   (radiosity/hidden.h)
+    HiddenOptions hidden;           // how hidden points are found
+    int shooter_level = 3;          // a shooter's unshot field is coarsened to at most this
+                                    //   level (the paper's "lower resolution version", section
+                                    //   6); the receiver options' shooter_coarsening levels at
+                                    //   least
+    bool ambient = true;            // beyond the paper: at the end, the power still unshot is
+                                    //   sent on through the measured coupling of the surfaces
+                                    //   (the fraction of each shooter's power each receiver got
+                                    //   in its last shot) and added as a constant radiosity per
+                                    //   surface (Cohen et al. 1988's ambient term, with measured
+                                    //   instead of area-weighted coupling)
 };
 
 /// The scene's `set` statements as solver options (shadows: the scene's method and rays).
@@ -69,6 +84,7 @@ struct SolveStats {
     long peak_memory_bytes = 0;  // the process's peak resident memory
     long coefficients = 0;       // coefficients of the solved fields (all surfaces, per channel)
     long kernel_evals = 0, rays = 0;
+    double ambient_power = 0;     // power the ambient correction added (sum of channels)
     std::vector<ShotStats> per_shot;
 };
 
@@ -108,11 +124,17 @@ private:
     DualTable dual_;
     Solution solution_;
     std::vector<std::vector<std::uint64_t>> split_cells_;  // per surface: cells split in some tree
+    /// coupling_[j][i]: the fraction of surface j's shot power (per channel) that reached
+    /// surface i in j's last shot (empty until j shoots).
+    std::vector<std::vector<Rgb>> coupling_;
+    /// The ambient correction of SolverOptions::ambient, per surface: a constant radiosity.
+    std::vector<Rgb> ambient_correction() const;
     double radiosity_scale_ = 0;
     double start_seconds_ = 0;
     /// Power weights w_kl = int int N_k N_l A per surface and level (cached).
     const std::vector<double>& power_weights(int surface, int level) const;
     mutable std::vector<std::vector<std::vector<double>>> weights_;
+    std::vector<HiddenMask> hidden_;  // per surface (empty masks when the option is off)
     Rgb power(int surface, const SplineField& field) const;
 };
 

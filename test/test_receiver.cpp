@@ -740,6 +740,7 @@ ReceiverState extrapolation_state(Extrapolation kind) {
     ReceiverState state;
     state.options.extrapolation = kind;
     state.options.clamp_factor = 1e6;  // no clamping unless a test asks for it
+    state.options.clamp_values = false;
     state.max_sample = 1;
     for (int e = 0; e < 4; ++e) {
         EdgeProfile& p = state.edges[e];
@@ -862,6 +863,30 @@ TEST_CASE("receiver: linear extrapolation clamps steep derivatives", "[receiver]
     // Unclamped derivatives within the range pass through (the top edge's g_t is about -0.1).
     state.edges[2].at(0.5, v, d);
     CHECK(extrapolate(state, 0.5, 1.3).r == Approx(v.r + 0.3 * g_t(0.5, 1)).epsilon(1e-14));
+}
+
+TEST_CASE("receiver: linear extrapolation keeps values near the samples' range", "[receiver]") {
+    // clamp_values: each channel of (23)-(25) stays within [lo - w, hi + w] for the samples'
+    // range [lo, hi] of width w. With a steep edge (derivative 1e3, as where a surface meets its
+    // shooter) the unclamped values 1 unit out would be about 1e3; clamped they are at most
+    // hi + w. Inside the band the extrapolation is untouched.
+    ReceiverState state = extrapolation_state(Extrapolation::Linear);
+    state.options.clamp_values = true;
+    state.sample_lo = {0, 0, 0};
+    state.sample_hi = {2, 4, 0};
+    for (Rgb& d : state.edges[0].derivative) d = {-1e3, -1e3, 0};  // grows below t = 0
+    const Rgb far = extrapolate(state, 0.5, -1.0);
+    CHECK(far.r == Approx(4).epsilon(1e-12));  // hi + w = 2 + 2
+    CHECK(far.g == Approx(8).epsilon(1e-12));  // 4 + 4
+    state.options.clamp_values = false;
+    CHECK(extrapolate(state, 0.5, -1.0).r > 500);  // what the clamp prevents
+    // Close to the edge the value is within the band and unchanged by the clamp.
+    state.options.clamp_values = true;
+    for (Rgb& d : state.edges[0].derivative) d = {-1, -1, 0};
+    Rgb v, d;
+    state.edges[0].at(0.5, v, d);
+    const Rgb near = extrapolate(state, 0.5, -0.01);
+    CHECK(near.r == Approx(v.r - 0.01 * d.r).epsilon(1e-12));
 }
 
 TEST_CASE("receiver: higher-order extrapolation meets (26) and (27)", "[receiver]") {

@@ -21,4 +21,8 @@ extern const PaperRow paper_table2[2];
 /// beside the area form factor, and a summary. Returns the process exit code.
 int run_paper_table(Args& args, const PaperRow* rows, int n_rows, bool parallel);
 
+/// Table 3: mu_{m;0,l} (l = 0..18) for m = 3 beside the paper's values, and m = 2, 4 (--csv,
+/// --eps). Returns 0 when all 19 values match the paper's six decimals, else 1.
+int run_table3(Args& args);
+
 }  // namespace mbr

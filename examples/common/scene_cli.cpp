@@ -75,7 +75,8 @@ SceneRun read_scene_run(Args& args, const std::string& default_scene) {
     if (shadows != "exact" && shadows != "paper" && shadows != "none")
         throw UsageError("--shadows must be exact, paper or none");
 
-    run.scene = load_scene(run.path);
+    const bool obj = run.path.size() > 4 && run.path.compare(run.path.size() - 4, 4, ".obj") == 0;
+    run.scene = obj ? load_obj(run.path) : load_scene(run.path);
     SolverOptions& o = run.options;
     o = solver_options(run.scene.settings);
     if (order > 0) o.receiver.m = order;
