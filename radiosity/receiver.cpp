@@ -858,6 +858,120 @@ void project_in_rhombi(ReceiverState& state, const DualTable& dn) {
     state.stats.n_projections += n;
 }
 
+// ---- Stages 6 and 8 on the finest grid (unify_by_projection) -------------------------------
+
+SplineField project_fine_grid(ReceiverState& state, const DualTable& dn) {
+    const int m = state.options.m;
+    const Forest& forest = state.forest;
+    int J = 0;
+    for (int index : forest.leaves(Forest::Region::Domain)) J = std::max(J, forest.node(index).cell.level);
+    for (const Fulcrum& f : state.fulcrums) J = std::max(J, f.level);
+    const ProjectionTables tables = make_projection_tables(m, dn, state.rhombus_radius, J);
+    const GaussLegendre& rule = tables.rule;
+    const int first = first_touching_index(m), n_coef = touching_count(m, J), cells = 1 << J;
+    // Cells within reach of some coefficient: DN(x - k) is kept for |x - k - m/2| <= r.
+    const double r = state.rhombus_radius;
+    const int lo = static_cast<int>(std::floor(first + 0.5 * m - r)) - 1;
+    const int hi = static_cast<int>(std::ceil(first + n_coef - 1 + 0.5 * m + r)) + 1;
+    const int n_cells = hi - lo;  // cells lo .. hi - 1 along each axis
+    const int n_nodes = n_cells * m;
+    // f[(j m + b) * n_nodes + (i m + a)]: the value at node (a, b) of cell (lo + i, lo + j).
+    std::vector<Rgb> f(size_t(n_nodes) * n_nodes);
+    std::vector<std::vector<std::vector<double>>> resample_rows(J + 1);  // [levels][index] -> m x m
+    for (int levels = 1; levels <= J; ++levels)
+        for (int index = 0; index < (1 << levels); ++index)
+            resample_rows[levels].push_back(subcell_resample_matrix(rule, levels, index));
+    parallel_for(n_cells, [&](int jj) {
+        const int j = lo + jj;
+        double channel_in[256], channel_out[256];
+        for (int ii = 0; ii < n_cells; ++ii) {
+            const int i = lo + ii;
+            Rgb* out_base = &f[size_t(jj * m) * n_nodes + size_t(ii * m)];
+            auto put = [&](int a, int b, Rgb v) { out_base[size_t(b) * n_nodes + a] = v; };
+            if (i < 0 || j < 0 || i >= cells || j >= cells) {
+                for (int b = 0; b < m; ++b)
+                    for (int a = 0; a < m; ++a)
+                        put(a, b, extrapolate(state, (i + 0.5 * (rule.x[a] + 1)) / cells,
+                                              (j + 0.5 * (rule.x[b] + 1)) / cells));
+                continue;
+            }
+            const int leaf = forest.find(DyadicCell{J, i, j});
+            const Forest::Node& node = forest.node(leaf);
+            MBR_CHECK_MSG(node.is_leaf() && node.samples >= 0, "cell " << node.cell << " has no samples");
+            const Rgb* s = &state.samples[size_t(node.samples) * m * m];  // s[a * m + b]
+            const int levels = J - node.cell.level;
+            if (levels == 0) {
+                for (int b = 0; b < m; ++b)
+                    for (int a = 0; a < m; ++a) put(a, b, s[a * m + b]);
+                continue;
+            }
+            const int sub_i = i - (node.cell.i << levels), sub_j = j - (node.cell.j << levels);
+            const double* Rx = resample_rows[levels][sub_i].data();
+            const double* Ry = resample_rows[levels][sub_j].data();
+            Rgb tmp[256];
+            for (int c = 0; c < 3; ++c) {
+                for (int q = 0; q < m * m; ++q) channel_in[q] = s[q][c];
+                resample(m, channel_in, Rx, Ry, channel_out);
+                for (int q = 0; q < m * m; ++q) tmp[q][c] = channel_out[q];
+            }
+            for (int b = 0; b < m; ++b)
+                for (int a = 0; a < m; ++a) put(a, b, tmp[a * m + b]);
+        }
+    });
+    // Eq. (19) in x = 2^J s units: c_kl = sum over cells and nodes of (w_a / 2)(w_b / 2)
+    // DN(i + x_a - k) DN(j + y_b - l) f; first along s for every node row, then along t.
+    const int reach = static_cast<int>(std::ceil(r)) + 1;
+    auto window = [&](int k, int& c0, int& c1) {  // cells i with DN(x - k) kept on them
+        const double centre = k + 0.5 * m;
+        c0 = std::max(lo, static_cast<int>(std::floor(centre - r)) - 1);
+        c1 = std::min(hi - 1, static_cast<int>(std::ceil(centre + r)));
+        (void)reach;
+    };
+    std::vector<Rgb> g(size_t(n_coef) * n_nodes);  // g[k * n_nodes + row]
+    parallel_for(n_nodes, [&](int row) {
+        const Rgb* fr = &f[size_t(row) * n_nodes];
+        for (int kk = 0; kk < n_coef; ++kk) {
+            const int k = first + kk;
+            int c0, c1;
+            window(k, c0, c1);
+            Rgb sum;
+            for (int i = c0; i <= c1; ++i)
+                for (int a = 0; a < m; ++a) {
+                    const double w = 0.5 * rule.w[a] * tables.dn(i - k, a);
+                    if (w != 0) sum += w * fr[size_t(i - lo) * m + a];
+                }
+            g[size_t(kk) * n_nodes + row] = sum;
+        }
+    });
+    SplineField field(m, J);
+    std::vector<Rgb> coef(size_t(n_coef) * n_coef);
+    parallel_for(n_coef, [&](int kk) {
+        const Rgb* gk = &g[size_t(kk) * n_nodes];
+        for (int ll = 0; ll < n_coef; ++ll) {
+            const int l = first + ll;
+            int c0, c1;
+            window(l, c0, c1);
+            Rgb sum;
+            for (int j = c0; j <= c1; ++j)
+                for (int b = 0; b < m; ++b) {
+                    const double w = 0.5 * rule.w[b] * tables.dn(j - l, b);
+                    if (w != 0) sum += w * gk[size_t(j - lo) * m + b];
+                }
+            coef[size_t(kk) * n_coef + ll] = sum;
+        }
+    });
+    for (int kk = 0; kk < n_coef; ++kk)
+        for (int ll = 0; ll < n_coef; ++ll) {
+            const Fulcrum fu{J, first + kk, first + ll};
+            Rgb c = coef[size_t(kk) * n_coef + ll];
+            if (state.mask) c = c * state.mask(fu);
+            field.set_coefficient(fu.k, fu.l, c);
+        }
+    state.stats.n_projections += n_coef * n_coef;
+    state.stats.level = J;
+    return field;
+}
+
 // ---- Stage 8: scale unification, eq. (17) ------------------------------------------------
 
 Rgb resolve_coefficient(ReceiverState& state, const DualTable& dn, const Fulcrum& f,
@@ -974,9 +1088,12 @@ SplineField transfer(const Shooter& shooter, const ReceiverSurface& receiver,
     sample_leaves(state, sampler);                                      //   eq. (21)
     state.stats.n_leaves = static_cast<int>(state.forest.leaves(Forest::Region::Domain).size());
     if (options.absolute_tolerance > 0 && options.rhombus_radius <= 0 && state.max_sample > 0) {
-        // DESIGN: a weak shot needs no more truncation accuracy than the scene's tolerance.
-        const double eps = std::clamp(options.absolute_tolerance / state.max_sample,
-                                      options.truncation_eps, std::max(options.truncation_eps, 1e-3));
+        // DESIGN: a weak shot needs no more truncation accuracy than the scene's tolerance. The
+        // error a truncation eps causes is about 50 eps relative to max|dB| (rea against eps on
+        // Tables 1-2, docs/method.md: 0.3-0.9 % at 1e-4, 0.04-0.07 % more at 1e-5 than at 1e-6),
+        // so eps = (absolute tolerance / max|dB|) / 50, at most 1e-4.
+        const double eps = std::clamp(0.02 * options.absolute_tolerance / state.max_sample,
+                                      options.truncation_eps, std::max(options.truncation_eps, 1e-4));
         state.rhombus_radius = dn.rhombus_radius(eps);
     }
     state.stats.rhombus_radius = state.rhombus_radius;
@@ -985,18 +1102,22 @@ SplineField transfer(const Shooter& shooter, const ReceiverSurface& receiver,
     fill_boundary(state, sampler);                                      // stage 3, eq. (22)
     state.stats.seconds_boundary = seconds_since(t);
     t = std::chrono::steady_clock::now();
-    expand_domain(state, sampler);                                      // stage 4, (23)-(27)
+    // With unify_by_projection the expanded domain is not built: project_fine_grid evaluates
+    // the extrapolation (23)-(27) at the nodes it needs.
+    const bool fine_grid = options.unify_by_projection;
+    if (!fine_grid) expand_domain(state, sampler);                      // stage 4, (23)-(27)
     state.stats.seconds_expanded = seconds_since(t);
     t = std::chrono::steady_clock::now();
     state.fulcrums = select_fulcrums(state.forest, options.m);          // stage 5
     state.stats.n_fulcrums = static_cast<int>(state.fulcrums.size());
-    project_in_rhombi(state, dn);                                       // stage 6, eq. (19)
+    if (!fine_grid) project_in_rhombi(state, dn);                       // stage 6, eq. (19)
     state.stats.seconds_projection = seconds_since(t);
     t = std::chrono::steady_clock::now();
     if (shadows == ShadowMethod::Fractions) apply_shadows(state, sampler, dn);  // stage 7, (28)
     state.stats.seconds_shadows = seconds_since(t);
     t = std::chrono::steady_clock::now();
-    SplineField result = unify_scales(state, dn);                       // stage 8, eq. (17)
+    SplineField result = fine_grid ? project_fine_grid(state, dn)       // stages 6 and 8
+                                   : unify_scales(state, dn);           // stage 8, eq. (17)
     state.mask = nullptr;  // it refers to the sampler, which ends here
     state.stats.seconds_projection += seconds_since(t);
     state.stats.n_rays += sampler.n_rays();

@@ -304,6 +304,16 @@ Vec2 fraction_point(const Fulcrum& f, int m);
 Rgb resolve_coefficient(ReceiverState& state, const DualTable& dn, const Fulcrum& f,
                         std::map<Fulcrum, Rgb>& refined);
 
+/// Stages 6 and 8 at once when ReceiverOptions::unify_by_projection is set (beyond the paper):
+/// every coefficient of the finest level J of the domain's leaves by (19), as two
+/// one-dimensional sums over the values at the m x m Gauss-Legendre nodes of every level-J cell
+/// within reach: the leaves' samples (a coarser leaf's polynomial resampled, as project() does)
+/// inside [0,1]^2, the extrapolation (23)-(27) evaluated at the nodes themselves outside (the
+/// limit of an infinitely fine expanded domain). DN is truncated to the square |x|, |y| <= r
+/// around each fulcrum, which holds the rhombus |x| + |y| <= r of Figure 3 (a tensor region is
+/// what makes the sums separable). Coefficients are masked with state.mask when it is set.
+SplineField project_fine_grid(ReceiverState& state, const DualTable& dn);
+
 /// Stage 8. Every coefficient at the finest fulcrum scale 2^-j, for the basis functions that
 /// touch [0,1]^2: a stored one is used; a missing one at a fulcrum whose neighbourhood is at
 /// least as fine as its scale is projected on demand; otherwise it comes from (17) applied to

@@ -89,6 +89,9 @@ SolverOptions solver_options(const SolverSettings& s) {
     // DESIGN: 4 against 5 points per cell: a scene's tolerances are absolute and coarse, where
     // the lower pair needs half the kernel evaluations of 6 against 7 (docs/method.md).
     o.receiver.quadrature.n = 4;
+    // DESIGN: every finest-level coefficient projected on the fine grid (project_fine_grid):
+    // adaptive trees then reach the accuracy of uniform ones (docs/method.md, adaptive study).
+    o.receiver.unify_by_projection = true;
     o.receiver.m = s.order;
     o.receiver.min_depth = s.min_depth;
     o.receiver.max_depth = s.max_depth;

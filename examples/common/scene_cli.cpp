@@ -32,6 +32,10 @@ const char* solver_options_usage =
     "  --shadows M               exact (visibility inside (21), default), paper (fractions\n"
     "                            (28) and masking) or none\n"
     "  --rays R                  paper shadows: rays per shooter patch, 1..4096\n"
+    "  --unify projection|paper  every finest coefficient projected on the fine grid\n"
+    "                            (default), or the paper's (17) from selected fulcrums\n"
+    "  --ambient on|off          the ambient correction of the unshot power (default on)\n"
+    "  --hidden on|off           hidden regions take their visible neighbours' values (on)\n"
     "  --threads n               OpenMP threads, 1..256 (default: all cores)\n"
     "  --quiet                   no progress bar\n";
 
@@ -56,6 +60,9 @@ SceneRun read_scene_run(Args& args, const std::string& default_scene) {
     const double tolerance = args.number("--tolerance", 1e-3);
     const std::string shadows = args.text("--shadows", "exact");
     const int rays = args.integer("--rays", -1);
+    const std::string unify = args.text("--unify", "projection");
+    const std::string ambient = args.text("--ambient", "on");
+    const std::string hidden = args.text("--hidden", "on");
     run.threads = args.integer("--threads", 0);
     run.quiet = args.flag("--quiet");
     const std::vector<std::string> pos = args.positional();
@@ -74,6 +81,9 @@ SceneRun read_scene_run(Args& args, const std::string& default_scene) {
     if (args.has("--threads")) in_range("--threads", run.threads, 1, 256);
     if (shadows != "exact" && shadows != "paper" && shadows != "none")
         throw UsageError("--shadows must be exact, paper or none");
+    if (unify != "projection" && unify != "paper") throw UsageError("--unify must be projection or paper");
+    for (const auto& [name, value] : {std::pair{"--ambient", ambient}, std::pair{"--hidden", hidden}})
+        if (value != "on" && value != "off") throw UsageError(std::string(name) + " must be on or off");
 
     const bool obj = run.path.size() > 4 && run.path.compare(run.path.size() - 4, 4, ".obj") == 0;
     run.scene = obj ? load_obj(run.path) : load_scene(run.path);
@@ -98,6 +108,9 @@ SceneRun read_scene_run(Args& args, const std::string& default_scene) {
                                 : shadows == "paper" ? ShadowMethod::Fractions
                                                      : ShadowMethod::None;
     if (rays > 0) o.receiver.shadows.rays_per_patch = rays;
+    o.ambient = ambient == "on";
+    o.receiver.unify_by_projection = unify == "projection";
+    o.hidden_regions = hidden == "on";
 #ifdef _OPENMP
     if (run.threads > 0) omp_set_num_threads(run.threads);
 #endif
