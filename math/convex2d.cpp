@@ -19,11 +19,12 @@ HalfPlane left_of(Vec2 a, Vec2 b) {
     return {normal, -dot(normal, a)};
 }
 
-ConvexPolygon clip(const ConvexPolygon& polygon, const HalfPlane& h) {
-    ConvexPolygon out;
+namespace {
+/// clip() into `out` (whose capacity is reused).
+void clip_into(const ConvexPolygon& polygon, const HalfPlane& h, ConvexPolygon& out) {
+    out.clear();
     const size_t n = polygon.size();
-    if (n < 3) return out;
-    out.reserve(n + 1);
+    if (n < 3) return;
     for (size_t i = 0; i < n; ++i) {
         const Vec2 a = polygon[i], b = polygon[(i + 1) % n];
         const double va = h.value(a), vb = h.value(b);
@@ -40,13 +41,26 @@ ConvexPolygon clip(const ConvexPolygon& polygon, const HalfPlane& h) {
     while (k > 1 && out[k - 1].x == out[0].x && out[k - 1].y == out[0].y) --k;
     out.resize(k);
     if (out.size() < 3 || signed_area(out) <= 0) out.clear();
+}
+}  // namespace
+
+ConvexPolygon clip(const ConvexPolygon& polygon, const HalfPlane& h) {
+    ConvexPolygon out;
+    out.reserve(polygon.size() + 1);
+    clip_into(polygon, h, out);
     return out;
 }
 
 ConvexPolygon intersect(const ConvexPolygon& a, const ConvexPolygon& b) {
-    ConvexPolygon out = a;
+    // Two buffers in turn: one allocation each, not one per clipping line.
+    ConvexPolygon out = a, next;
+    out.reserve(a.size() + b.size());
+    next.reserve(a.size() + b.size());
     const size_t n = b.size();
-    for (size_t i = 0; i < n && !out.empty(); ++i) out = clip(out, left_of(b[i], b[(i + 1) % n]));
+    for (size_t i = 0; i < n && !out.empty(); ++i) {
+        clip_into(out, left_of(b[i], b[(i + 1) % n]), next);
+        out.swap(next);
+    }
     if (!out.empty() && signed_area(out) <= 0) out.clear();
     return out;
 }

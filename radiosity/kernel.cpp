@@ -69,11 +69,13 @@ IncrementIntegrator::IncrementIntegrator(const Shooter& shooter, const Quadratur
     planar_ = shooter.surface->kind() == Surface::Kind::PlanarQuad;
     if (planar_) {
         plane_ = make_shooter_plane(*shooter.surface);
-        tri_rules_.resize(options.n + 2);
-        for (int n = 1; n <= options.n + 1; ++n) tri_rules_[n] = triangle_rule(n);
+        const int top = std::max(options.n, options.n_pieces) + 1;
+        tri_rules_.resize(top + 1);
+        for (int n = 1; n <= top; ++n) tri_rules_[n] = triangle_rule(n);
     }
     if (occlusion && !occlusion->clear()) occlusion_ = occlusion;
     analytic_ = planar_ && unshot_constant_ && options.analytic;
+    if (planar_ && !unshot_constant_) unshot_patches_ = PolynomialPatches(shooter.unshot);
 }
 
 Rgb IncrementIntegrator::analytic_value(const SurfacePoint& p) {
@@ -151,6 +153,143 @@ Rgb IncrementIntegrator::sum_over(const SurfacePoint& p, PointSpan pts) const {
     return sum;
 }
 
+Rgb IncrementIntegrator::triangle_value(const SurfacePoint& p, Vec2 a, Vec2 b, Vec2 c, int n) {
+    // The n x n collapsed Gauss rule on one triangle of the shooter's plane:
+    // int F(p, x) (B_h(u(x), v(x)) - b*) dA(x).
+    const TriangleRule& rule = tri_rules_[n];
+    const double jacobian = std::fabs(cross(b - a, c - a));
+    Rgb sum;
+    if (jacobian <= 0) return sum;
+    const Rgb constant_b = unshot_constant_ ? shooter_.unshot.coefficient(0, 0) : Rgb{};
+    // (u, v) at the corners exactly; at a node, their affine blend refined by a Newton step
+    // (the inverse of the bilinear map is nearly affine over one triangle).
+    Vec2 uv_a, uv_b, uv_c;
+    if (!unshot_constant_) {
+        uv_a = plane_.parameters(a);
+        uv_b = plane_.parameters(b);
+        uv_c = plane_.parameters(c);
+    }
+    for (size_t q = 0; q < rule.points.size(); ++q) {
+        const double xi = rule.points[q].x, eta = rule.points[q].y;
+        const Vec2 X = a + xi * (b - a) + eta * (c - a);
+        const double F = form_factor_kernel(p.position, p.normal, plane_.to_space(X), plane_.normal);
+        ++extra_evaluations_;
+        if (F == 0) continue;
+        Rgb B = constant_b;
+        if (!unshot_constant_) {
+            const Vec2 guess = uv_a + xi * (uv_b - uv_a) + eta * (uv_c - uv_a);
+            const Vec2 uv = plane_.refine_parameters(X, plane_.refine_parameters(X, guess));
+            B = unshot_patches_(uv.x, uv.y);
+        }
+        sum += (rule.weights[q] * jacobian * F) * (B - b_star_);
+    }
+    return sum;
+}
+
+Rgb IncrementIntegrator::shadow_integral(const SurfacePoint& p, double tolerance, double near_field,
+                                         std::vector<ShadowTriangle>* kept) {
+    // The shadowed part, fan triangles refined worst first (as AdaptiveOptions::global) until
+    // the n against n + 1 estimates sum to the tolerance; a triangle too close to p for its
+    // size (near_field) is split whatever its estimate.
+    struct Item {
+        ShadowTriangle t;
+        Rgb f1;
+        double error;
+    };
+    auto corner = [&](const ShadowTriangle& t, int k) {
+        const ConvexPolygon& piece = shadow_regions_[t.region];
+        const Vec2 a = piece[0], b = piece[t.fan], c = piece[t.fan + 1];
+        const Vec2 w = t.bary[k];  // weights of b and c
+        return a + w.x * (b - a) + w.y * (c - a);
+    };
+    auto too_near = [&](const Vec2 (&v)[3]) {
+        if (near_field <= 0) return false;
+        Box3 box;
+        for (const Vec2& q : v) box.extend(plane_.to_space(q));
+        const Vec3 gap = max(max(box.lo - p.position, p.position - box.hi), Vec3{0, 0, 0});
+        return length(box.extent()) > near_field * length(gap);
+    };
+    std::vector<Item> heap, done;
+    double total = 0;
+    auto worse = [](const Item& x, const Item& y) { return x.error < y.error; };
+    const int n_tri = options_.n_pieces > 0 ? options_.n_pieces : options_.n;
+    std::vector<ShadowTriangle> todo;
+    for (size_t r = 0; r < shadow_regions_.size(); ++r)
+        for (size_t k = 1; k + 1 < shadow_regions_[r].size(); ++k)
+            todo.push_back({int(r), int(k), {{0, 0}, {1, 0}, {0, 1}}, 0});
+    auto evaluate = [&]() {
+        while (!todo.empty()) {
+            const ShadowTriangle t = todo.back();
+            todo.pop_back();
+            const Vec2 v[3] = {corner(t, 0), corner(t, 1), corner(t, 2)};
+            if (t.level < 12 && too_near(v)) {
+                for (const ShadowTriangle& ch : t.children()) todo.push_back(ch);
+                continue;
+            }
+            const Rgb f0 = triangle_value(p, v[0], v[1], v[2], n_tri);
+            const Rgb f1 = triangle_value(p, v[0], v[1], v[2], n_tri + 1);
+            const double error = max_abs(f1 - f0);
+            total += error;
+            Item item{t, f1, error};
+            if (t.level >= 12) {
+                done.push_back(item);
+            } else {
+                heap.push_back(item);
+                std::push_heap(heap.begin(), heap.end(), worse);
+            }
+        }
+    };
+    evaluate();
+    while (total > tolerance && !heap.empty() && heap.size() + done.size() < 4000) {
+        std::pop_heap(heap.begin(), heap.end(), worse);
+        const Item w = heap.back();
+        heap.pop_back();
+        total -= w.error;
+        for (const ShadowTriangle& ch : w.t.children()) todo.push_back(ch);
+        evaluate();
+    }
+    // A fixed order of summation: by region, fan triangle, level and position.
+    heap.insert(heap.end(), done.begin(), done.end());
+    std::sort(heap.begin(), heap.end(), [](const Item& x, const Item& y) { return x.t < y.t; });
+    Rgb sum;
+    for (const Item& it : heap) {
+        sum += it.f1;
+        if (kept) kept->push_back(it.t);
+    }
+    return sum;
+}
+
+Rgb IncrementIntegrator::shadow_on(const SurfacePoint& p, const std::vector<ShadowTriangle>& triangles) {
+    Rgb sum;
+    for (const ShadowTriangle& t : triangles) {
+        if (t.region >= int(shadow_regions_.size()) || t.fan + 1 >= int(shadow_regions_[t.region].size()))
+            continue;  // the shadow's outline changed between the two points: part not found
+        const ConvexPolygon& piece = shadow_regions_[t.region];
+        const Vec2 a = piece[0], b = piece[t.fan], c = piece[t.fan + 1];
+        Vec2 v[3];
+        for (int k = 0; k < 3; ++k) v[k] = a + t.bary[k].x * (b - a) + t.bary[k].y * (c - a);
+        sum += triangle_value(p, v[0], v[1], v[2], (options_.n_pieces > 0 ? options_.n_pieces : options_.n) + 1);
+    }
+    return sum;
+}
+
+void IncrementIntegrator::take_shadows_apart() {
+    // Disjoint convex parts of the union of the shadows (each minus the earlier ones), clipped
+    // to the front of the horizon; the cells then see the horizon alone.
+    for (size_t s = 0; s < view_.shadows.size(); ++s) {
+        std::vector<ConvexPolygon> parts{view_.horizon_cuts ? clip(view_.shadows[s], view_.front) : view_.shadows[s]};
+        for (size_t t = 0; t < s && !parts.empty(); ++t) {
+            std::vector<ConvexPolygon> next;
+            for (const ConvexPolygon& part : parts)
+                for (ConvexPolygon& rest : subtract(part, view_.shadows[t])) next.push_back(std::move(rest));
+            parts = std::move(next);
+        }
+        for (ConvexPolygon& part : parts)
+            if (!part.empty()) shadow_regions_.push_back(std::move(part));
+    }
+    view_.shadows.clear();
+}
+
 void IncrementIntegrator::set_view(const SurfacePoint& p) {
     b_star_ = Rgb{};
     extra_evaluations_ = 0;
@@ -158,13 +297,15 @@ void IncrementIntegrator::set_view(const SurfacePoint& p) {
     mixed_.clear();
     pieces_key_ = ~0ULL;
     if (planar_ && (options_.clip_horizon || occlusion_))
-        view_ = blocked_view(plane_, p.position, p.normal, occlusion_);
+        view_ = blocked_view(plane_, p.position, p.normal, occlusion_,
+                             receiver_plane_ ? &*receiver_plane_ : nullptr);
     else
         view_ = BlockedView{};
     if (!options_.clip_horizon) {  // shadows only: the horizon is left to the clamped cosine
         view_.horizon_cuts = false;
         view_.behind_all = false;
     }
+    shadow_regions_.clear();
 }
 
 ConvexPolygon IncrementIntegrator::cell_image(const QuadCell& cell) const {
@@ -179,7 +320,9 @@ Rgb IncrementIntegrator::pieces_value(const SurfacePoint& p, const std::vector<C
     // The n x n collapsed Gauss rule on a fan of triangles of each convex piece, in the shooter's
     // plane: int F(p, x) B_h(u(x), v(x)) dA(x) (dA is the plane's own area element, so the area
     // factor A_h of the parameter map does not appear).
-    const TriangleRule& rule = tri_rules_[n];
+    // The cell's n or n+1 stands for the pieces' pair (n_pieces, n_pieces + 1).
+    const int np = options_.n_pieces > 0 ? options_.n_pieces + (n - options_.n) : n;
+    const TriangleRule& rule = tri_rules_[np];
     const Rgb constant_b = unshot_constant_ ? shooter_.unshot.coefficient(0, 0) : Rgb{};
     Rgb sum;
     for (const ConvexPolygon& piece : pieces)
@@ -195,7 +338,7 @@ Rgb IncrementIntegrator::pieces_value(const SurfacePoint& p, const std::vector<C
                 Rgb B = constant_b;
                 if (!unshot_constant_) {
                     const Vec2 uv = plane_.parameters(X);
-                    B = shooter_.unshot.evaluate(std::clamp(uv.x, 0.0, 1.0), std::clamp(uv.y, 0.0, 1.0));
+                    B = unshot_patches_(uv.x, uv.y);
                 }
                 sum += (rule.weights[q] * jacobian * F) * (B - b_star_);
             }
@@ -203,10 +346,45 @@ Rgb IncrementIntegrator::pieces_value(const SurfacePoint& p, const std::vector<C
     return sum;
 }
 
+IncrementIntegrator::PointSpan IncrementIntegrator::horizon_points(const QuadCell& cell, int n,
+                                                                   const ConvexPolygon& image) {
+    // The front piece of a cell only the receiver's fixed horizon cuts: its n x n triangle-rule
+    // points, with e = w J B_h and a = w J as for the tensor points (the plane's own area
+    // element, no A_h), computed once per cell and rule like points().
+    const std::uint64_t key = (cell_key(cell) << 1) | std::uint64_t(n == options_.n ? 0 : 1);
+    auto it = horizon_cache_.find(key);
+    if (it == horizon_cache_.end()) {
+        if (horizon_cache_.size() > 200000) horizon_cache_.clear();  // bound it; values never depend on it
+        std::vector<ShooterPoint> pts;
+        const ConvexPolygon piece = clip(image, view_.front);
+        const TriangleRule& rule = tri_rules_[n];
+        const Rgb constant_b = unshot_constant_ ? shooter_.unshot.coefficient(0, 0) : Rgb{};
+        for (size_t k = 1; k + 1 < piece.size(); ++k) {
+            const Vec2 a = piece[0], b = piece[k], c = piece[k + 1];
+            const double jacobian = std::fabs(cross(b - a, c - a));
+            if (jacobian <= 0) continue;
+            for (size_t q = 0; q < rule.points.size(); ++q) {
+                const Vec2 X = a + rule.points[q].x * (b - a) + rule.points[q].y * (c - a);
+                const double w = rule.weights[q] * jacobian;
+                Rgb B = constant_b;
+                if (!unshot_constant_) {
+                    const Vec2 uv = plane_.parameters(X);
+                    B = unshot_patches_(uv.x, uv.y);
+                }
+                pts.push_back({plane_.to_space(X), plane_.normal, w * B, w});
+            }
+        }
+        it = horizon_cache_.emplace(key, std::move(pts)).first;
+    }
+    extra_evaluations_ += long(it->second.size()) - long(n) * n;  // the rule counts n^2 per cell
+    return {it->second.data(), static_cast<int>(it->second.size())};
+}
+
 Rgb IncrementIntegrator::cell_value(const SurfacePoint& p, const QuadCell& cell, int n) {
     if (planar_ && !view_.trivial()) {
         const ConvexPolygon image = cell_image(cell);
-        switch (classify_cell(image, view_)) {
+        bool shadowed = false;
+        switch (classify_cell(image, view_, &shadowed)) {
             case CellVisibility::hidden: return Rgb{};
             case CellVisibility::clear: return sum_over(p, points(cell, n));
             case CellVisibility::cut: {
@@ -215,6 +393,7 @@ Rgb IncrementIntegrator::cell_value(const SurfacePoint& p, const QuadCell& cell,
                     mixed_.push_back(key);  // split without integrating its pieces
                     return Rgb{};
                 }
+                if (!shadowed && receiver_plane_) return sum_over(p, horizon_points(cell, n, image));
                 if (key != pieces_key_) {  // the n and n+1 rules of one cell share the pieces
                     pieces_ = visible_pieces(image, view_);
                     pieces_key_ = key;
@@ -275,6 +454,18 @@ IncrementIntegrator::Result IncrementIntegrator::integrate(const SurfacePoint& p
     AdaptiveOptions opt;
     opt.n = options_.n;
     opt.tolerance = std::max(options_.rel_tolerance * scale, options_.abs_tolerance);
+    // Shadow subtraction (QuadratureOptions::shadow_subtraction): the cells below see only the
+    // horizon; the part of the shooter the shadows hide (in front of p) is integrated here on
+    // its own, its fan triangles split uniformly until two depths agree within half the
+    // tolerance, and subtracted. The rule over the cells gets the other half.
+    Rgb shadowed;
+    if (planar_ && options_.shadow_subtraction && !view_.shadows.empty()) {
+        take_shadows_apart();
+        const double share = 0.5 * opt.tolerance;
+        opt.tolerance -= share;
+        shadowed = shadow_integral(p, share, near_field, &result.shadow_triangles);
+        result.shadow_subtracted = true;
+    }
     opt.max_depth = options_.max_depth;
     // Per-node visibility on a curved shooter: a visibility step never passes the n against
     // n + 1 test, so without this cap its cells would split down to max_depth.
@@ -307,7 +498,8 @@ IncrementIntegrator::Result IncrementIntegrator::integrate(const SurfacePoint& p
         return length(box.extent()) > near_field * length(gap);
     };
     auto r = adaptive_tensor_rule_2d(cell_rule, root.rect, opt, keep_partition, near);
-    result.value = r.value + exact_part;
+    result.value = r.value + exact_part - shadowed;
+    if (!keep_partition) result.shadow_triangles.clear();
     result.n_evaluations = r.n_evaluations + long(options_.n + 1) * (options_.n + 1) + extra_evaluations_;
     result.n_rays = rays_;
     result.converged = r.converged;
@@ -323,6 +515,12 @@ Rgb IncrementIntegrator::integrate_on(const SurfacePoint& p,
     if (made_by && max_abs(made_by->subtracted) > 0) {  // the same constant subtracted
         b_star_ = made_by->subtracted;
         sum = visible_form_factor(p) * b_star_;
+    }
+    if (made_by && made_by->shadow_subtracted && !view_.shadows.empty()) {
+        // The shadowed part on the triangles the partition's point kept: the same refinement
+        // at both points, so a divided difference (22) of them stays smooth.
+        take_shadows_apart();
+        sum -= shadow_on(p, made_by->shadow_triangles);
     }
     if (!view_.behind_all)
         for (const auto& c : partition) sum += cell_value(p, c.cell, options_.n + 1);

@@ -4,7 +4,9 @@
 // (section 7: "an analytic formula advocated in [7]", Baum, Rushmeier and Winget 1989).
 #pragma once
 
+#include <array>
 #include <cstdint>
+#include <optional>
 #include <unordered_map>
 #include <vector>
 
@@ -60,6 +62,12 @@ struct QuadratureOptions {
                                   //   first shot): I(p) by the contour formula over the
                                   //   visible pieces, no quadrature (not when a partition is
                                   //   asked for)
+    bool shadow_subtraction = true;  // planar shooters with occluders: the cells see only the
+                                  //   horizon, and the shadowed part (the union of the shadows
+                                  //   in front) is integrated on its own and subtracted; else
+                                  //   each cut cell's visible pieces are integrated
+    int n_pieces = 0;             // the rule pair on cut cells' pieces: n_pieces against
+                                  //   n_pieces + 1 points per triangle side (0: n, as cells)
     int min_cut_level = 1;        // a cell the horizon or a shadow cuts is split down to this
                                   //   level before its visible pieces are integrated (the
                                   //   root's pieces would be many; deeper cells are split by
@@ -90,6 +98,33 @@ struct ShooterPoint {
     double a = 0;  // w_a w_b J A_h(u,v): e without B_h (for the singularity subtraction)
 };
 
+/// A triangle of the shadowed part of a shooter (shadow subtraction): fan triangle `fan` of the
+/// shadow region `region`, and three points in its barycentric coordinates (weights of its
+/// second and third corners), `level` halvings deep.
+struct ShadowTriangle {
+    int region = 0, fan = 1;
+    Vec2 bary[3];
+    int level = 0;
+    /// The four triangles of its edges' midpoints.
+    std::array<ShadowTriangle, 4> children() const {
+        const Vec2 ab = 0.5 * (bary[0] + bary[1]), bc = 0.5 * (bary[1] + bary[2]), ca = 0.5 * (bary[2] + bary[0]);
+        return {ShadowTriangle{region, fan, {bary[0], ab, ca}, level + 1},
+                ShadowTriangle{region, fan, {ab, bary[1], bc}, level + 1},
+                ShadowTriangle{region, fan, {ca, bc, bary[2]}, level + 1},
+                ShadowTriangle{region, fan, {ab, bc, ca}, level + 1}};
+    }
+    bool operator<(const ShadowTriangle& o) const {
+        if (region != o.region) return region < o.region;
+        if (fan != o.fan) return fan < o.fan;
+        if (level != o.level) return level < o.level;
+        for (int k = 0; k < 3; ++k) {
+            if (bary[k].x != o.bary[k].x) return bary[k].x < o.bary[k].x;
+            if (bary[k].y != o.bary[k].y) return bary[k].y < o.bary[k].y;
+        }
+        return false;
+    }
+};
+
 /// The integral of eq. (21) without the receiver's reflectance:
 ///   I(p) = int_{[0,1]^2} F(p, x_h(u,v)) VIS B_h(u,v) A_h(u,v) du dv,
 /// by the adaptive rule of section 6 (n against n + 1 points per cell, split in four with a
@@ -109,6 +144,8 @@ public:
         long n_rays = 0;          // visibility rays (exact visibility on a curved shooter)
         Rgb subtracted;           // B_h(x*) when the singularity was subtracted (the partition's
                                   //   cell values are then those of the remainder)
+        bool shadow_subtracted = false;  // the shadowed part was integrated on its own
+        std::vector<ShadowTriangle> shadow_triangles;  // its triangles (integrate_on reuses them)
         bool converged = true;
         std::vector<AcceptedCell<Rgb>> partition;  // the shooter's cells, when asked for
     };
@@ -132,6 +169,9 @@ public:
     PointSpan points(const QuadCell& cell, int n);
     /// True when integrate() uses the closed form (QuadratureOptions::analytic).
     bool analytic() const { return analytic_; }
+    /// Every receiving point lies on this plane (a planar receiver): the horizon is one line,
+    /// and the points of the cells it cuts are cached like the others.
+    void set_receiver_plane(const Plane& plane) { receiver_plane_ = plane; }
 
 private:
     Rgb sum_over(const SurfacePoint& p, PointSpan pts) const;
@@ -145,6 +185,15 @@ private:
     Rgb analytic_value(const SurfacePoint& p);
     ConvexPolygon cell_image(const QuadCell& cell) const;
     Rgb pieces_value(const SurfacePoint& p, const std::vector<ConvexPolygon>& pieces, int n);
+    Rgb triangle_value(const SurfacePoint& p, Vec2 a, Vec2 b, Vec2 c, int n);
+    /// int F (B_h - b*) over the shadowed part (shadow_regions_) to `tolerance`, adaptively
+    /// over its fan triangles; the triangles kept are appended to *kept.
+    Rgb shadow_integral(const SurfacePoint& p, double tolerance, double near_field,
+                        std::vector<ShadowTriangle>* kept);
+    /// The same on given triangles (those another point kept), with the n + 1 rule.
+    Rgb shadow_on(const SurfacePoint& p, const std::vector<ShadowTriangle>& triangles);
+    std::vector<ConvexPolygon> shadow_regions_;  // disjoint convex parts of the shadows in front
+    void take_shadows_apart();  // view_'s shadows -> shadow_regions_ (then view_ has none)
 
     const Shooter& shooter_;
     QuadratureOptions options_;
@@ -161,6 +210,11 @@ private:
                                         //   cut cells above min_cut_level (planar): split
     std::uint64_t pieces_key_ = ~0ULL;  // the cut cell whose pieces are in pieces_
     std::vector<ConvexPolygon> pieces_;
+    PolynomialPatches unshot_patches_;  // B_h for scattered points (cut pieces)
+    std::optional<Plane> receiver_plane_;  // set_receiver_plane
+    /// The front pieces' points of cells only the (fixed) horizon cuts, per cell and rule.
+    std::unordered_map<std::uint64_t, std::vector<ShooterPoint>> horizon_cache_;
+    PointSpan horizon_points(const QuadCell& cell, int n, const ConvexPolygon& image);
     std::vector<GaussLegendre> rules_;  // rules_[n]
     std::vector<ShooterPoint> pool_;    // every cached cell's points, one after the other
     std::vector<Rgb> unshot_values_;    // scratch: B_h on one cell's grid

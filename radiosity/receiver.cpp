@@ -82,8 +82,11 @@ IncrementSampler::IncrementSampler(const Shooter& shooter, const ReceiverSurface
                                    const OcclusionContext* occlusion)
     : shooter_(shooter), receiver_(receiver) {
     MBR_CHECK(receiver.surface != nullptr && receiver.reflectance);
-    for (int i = 0; i < thread_count(); ++i)
+    const std::optional<Plane> plane = surface_plane(*receiver.surface);
+    for (int i = 0; i < thread_count(); ++i) {
         integrators_.push_back(std::make_unique<IncrementIntegrator>(shooter, options, occlusion));
+        if (plane) integrators_.back()->set_receiver_plane(*plane);
+    }
     rays_.assign(integrators_.size(), 0);
 }
 
@@ -181,8 +184,8 @@ void subdivide_by_oracle(ReceiverState& state, IncrementSampler& sampler) {
                 largest = std::max(largest, max_abs(f_c[a * nc + b]));
             }
         *increments += m * m + nc * nc;
-        const double tol =
-            std::max(opt.oracle_tolerance * std::max(largest, 0.01 * scale), opt.absolute_tolerance);
+        const double tol = std::max(opt.oracle_tolerance * std::max(largest, 0.01 * scale),
+                                    opt.oracle_share * opt.absolute_tolerance);
         for (int a = 0; a < nc; ++a)
             for (int b = 0; b < nc; ++b) {
                 Rgb p;
@@ -203,6 +206,11 @@ void subdivide_by_oracle(ReceiverState& state, IncrementSampler& sampler) {
         stats.n_increments += increments;
         stats.n_oracle_increments += increments;
     }
+    // DESIGN (cost follows energy): a receiver whose largest root sample is below
+    // weak_receiver times the absolute tolerance starts the oracle at the root.
+    int min_depth = opt.min_depth;
+    if (opt.weak_receiver > 0 && opt.absolute_tolerance > 0 && scale < opt.weak_receiver * opt.absolute_tolerance)
+        min_depth = 0;
 
     enum Action { Leaf, Split, SplitOnceMore };
     std::vector<int> frontier{forest.domain_root()};
@@ -212,7 +220,7 @@ void subdivide_by_oracle(ReceiverState& state, IncrementSampler& sampler) {
         std::vector<long> evals(n, 0), increments(n, 0);
         parallel_for(n, [&](int c) {
             const DyadicCell cell = forest.node(frontier[c]).cell;
-            if (cell.level < opt.min_depth) {
+            if (cell.level < min_depth) {
                 action[c] = Split;
                 return;
             }
@@ -230,7 +238,7 @@ void subdivide_by_oracle(ReceiverState& state, IncrementSampler& sampler) {
             // DESIGN: relative agreement, with a floor at 1% of the largest value in the domain
             // so that nearly dark cells do not split forever.
             const double tol = std::max(opt.oracle_tolerance * std::max(max_abs(fine), 0.01 * scale),
-                                        opt.absolute_tolerance);
+                                        opt.oracle_share * opt.absolute_tolerance);
             action[c] = max_abs(fine - coarse) <= tol ? SplitOnceMore : Split;
         });
         std::vector<int> next;

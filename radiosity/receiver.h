@@ -91,6 +91,11 @@ struct ReceiverOptions {
                                        //   of refining coarse ones by (17) (not the paper's rule)
     QuadratureOptions quadrature;      // the adaptive rule over the shooter, section 6
     ShadowOptions shadows;             // stage 7 (used when the transfer has occluders)
+    double weak_receiver = 0;          // > 0: a receiver whose root samples are all below this
+                                       //   many absolute tolerances starts the oracle at depth 0
+    double oracle_share = 1;           // the oracle's absolute tolerance: this share of
+                                       //   absolute_tolerance (a cell's means agree far better
+                                       //   than its spline fits it)
     double absolute_tolerance = 0;     // radiosity below which differences never refine: the
                                        //   oracle, edgefill and shadow tests use the larger of
                                        //   their relative tolerance and this, and the truncation

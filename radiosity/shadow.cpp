@@ -185,15 +185,53 @@ ShooterPlane make_shooter_plane(const Surface& quad) {
     sp.e2 = cross(sp.normal, sp.e1);
     for (int i = 0; i < 4; ++i) sp.corner[i] = sp.to_plane(c[i]);
     sp.outline.assign(sp.corner, sp.corner + 4);
+    // An exact parallelogram (the twist q0 - q1 + q2 - q3 vanishes to rounding): affine inverse.
+    const Vec2 e = sp.corner[1] - sp.corner[0], f = sp.corner[3] - sp.corner[0];
+    const Vec2 g = sp.corner[0] - sp.corner[1] + sp.corner[2] - sp.corner[3];
+    const double det = cross(e, f);
+    if (det != 0 && std::sqrt(dot(g, g)) <= 1e-14 * std::sqrt(std::fabs(det))) {
+        sp.parallelogram = true;
+        sp.inverse_row0 = Vec2{f.y, -f.x} * (1 / det);
+        sp.inverse_row1 = Vec2{-e.y, e.x} * (1 / det);
+    }
     if (signed_area(sp.outline) < 0) std::reverse(sp.outline.begin(), sp.outline.end());
     return sp;
 }
 
+std::optional<Plane> surface_plane(const Surface& surface) {
+    if (surface.kind() == Surface::Kind::PlanarQuad) {
+        const Vec3* c = surface.corners();
+        Vec3 n{};
+        for (int i = 0; i < 4; ++i) n += cross(c[i], c[(i + 1) % 4]);
+        n = normalize(n);
+        const Vec3 o = 0.25 * (c[0] + c[1] + c[2] + c[3]);
+        // Only a quad planar to rounding: the scene format accepts corners 0.25 % off their
+        // mean plane, whose tangent planes then differ from it.
+        double size = 0, off = 0;
+        for (int i = 0; i < 4; ++i) {
+            size = std::max(size, length(c[i] - c[(i + 2) % 4]));
+            off = std::max(off, std::fabs(dot(n, c[i] - o)));
+        }
+        if (off > 1e-12 * size) return std::nullopt;
+        return Plane{n, dot(n, o)};
+    }
+    if (surface.kind() == Surface::Kind::Disk) {
+        const Vec3 n = surface.normal(0.5, 0.5);
+        return Plane{n, dot(n, surface.point(0.5, 0.5))};
+    }
+    return std::nullopt;
+}
+
 BlockedView blocked_view(const ShooterPlane& plane, Vec3 p, Vec3 n_p,
-                         const OcclusionContext* context) {
+                         const OcclusionContext* context, const Plane* receiver_plane) {
     BlockedView view;
-    // The horizon: the shooter's points x with n_p . (x - p) > 0 are in front of p.
-    view.front = HalfPlane{{dot(n_p, plane.e1), dot(n_p, plane.e2)}, dot(n_p, plane.origin - p)};
+    // The horizon: the shooter's points x with n_p . (x - p) > 0 are in front of p (or, for a
+    // point of a planar receiver, in front of the receiver's plane: the same line each time).
+    if (receiver_plane)
+        view.front = HalfPlane{{dot(receiver_plane->normal, plane.e1), dot(receiver_plane->normal, plane.e2)},
+                               dot(receiver_plane->normal, plane.origin) - receiver_plane->offset};
+    else
+        view.front = HalfPlane{{dot(n_p, plane.e1), dot(n_p, plane.e2)}, dot(n_p, plane.origin - p)};
     int n_front = 0, n_behind = 0;
     for (const Vec2& q : plane.corner) {
         const double v = view.front.value(q);
@@ -268,22 +306,43 @@ void merge_shadows(std::vector<ConvexPolygon>& shadows) {
     // union, until no pair merges (the faces of a convex solid usually end as one polygon,
     // its silhouette's).
     // DESIGN: the convexity test's tolerance, 1e-9 of the hull's area, only absorbs rounding.
+    struct Box {
+        Vec2 lo{HUGE_VAL, HUGE_VAL}, hi{-HUGE_VAL, -HUGE_VAL};
+    };
+    auto box_of = [](const ConvexPolygon& s) {
+        Box b;
+        for (const Vec2& q : s) {
+            b.lo = {std::min(b.lo.x, q.x), std::min(b.lo.y, q.y)};
+            b.hi = {std::max(b.hi.x, q.x), std::max(b.hi.y, q.y)};
+        }
+        return b;
+    };
+    std::vector<Box> boxes;
+    for (const ConvexPolygon& s : shadows) boxes.push_back(box_of(s));
     for (bool merged = true; merged;) {
         merged = false;
-        for (size_t i = 0; i < shadows.size() && !merged; ++i)
-            for (size_t j = i + 1; j < shadows.size() && !merged; ++j) {
+        for (size_t i = 0; i < shadows.size(); ++i)
+            for (size_t j = i + 1; j < shadows.size(); ++j) {
+                // Shadows whose boxes do not even touch cannot have a convex union.
+                const Box& a = boxes[i];
+                const Box& b = boxes[j];
+                if (a.hi.x < b.lo.x || b.hi.x < a.lo.x || a.hi.y < b.lo.y || b.hi.y < a.lo.y) continue;
                 // Overlapping, nested or only touching along an edge (two faces of one solid):
                 // the hull is the union exactly when the union is convex.
                 ConvexPolygon u = convex_union(shadows[i], shadows[j]);
                 if (u.empty()) continue;
                 shadows[i] = std::move(u);
+                boxes[i] = box_of(shadows[i]);
                 shadows.erase(shadows.begin() + long(j));
+                boxes.erase(boxes.begin() + long(j));
                 merged = true;
+                j = i;  // shadow i grew: check it against the others again
             }
     }
 }
 
-CellVisibility classify_cell(const ConvexPolygon& cell, const BlockedView& view) {
+CellVisibility classify_cell(const ConvexPolygon& cell, const BlockedView& view, bool* shadowed) {
+    if (shadowed) *shadowed = false;
     if (view.behind_all) return CellVisibility::hidden;
     bool cut = false;
     if (view.horizon_cuts) {
@@ -299,7 +358,10 @@ CellVisibility classify_cell(const ConvexPolygon& cell, const BlockedView& view)
     for (const ConvexPolygon& s : view.shadows) {
         const Overlap o = classify(cell, s);
         if (o == Overlap::inside) return CellVisibility::hidden;
-        if (o == Overlap::partial) cut = true;
+        if (o == Overlap::partial) {
+            cut = true;
+            if (shadowed) *shadowed = true;
+        }
     }
     return cut ? CellVisibility::cut : CellVisibility::clear;
 }

@@ -19,6 +19,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "math/convex2d.h"
@@ -83,9 +84,28 @@ struct ShooterPlane {
     Vec3 to_space(Vec2 q) const { return origin + q.x * e1 + q.y * e2; }
     /// The point of the bilinear map at (u, v), in the frame.
     Vec2 at(double u, double v) const;
+    bool parallelogram = false;       // the map is affine: parameters() by a 2 x 2 inverse
+    Vec2 inverse_row0, inverse_row1;  // that inverse (when parallelogram)
     /// (u, v) of a point of the plane (inverse bilinear map).
     Vec2 parameters(Vec2 q) const {
+        if (parallelogram) {
+            const Vec2 d = q - corner[0];
+            return {dot(inverse_row0, d), dot(inverse_row1, d)};
+        }
         return inverse_bilinear(corner[0], corner[1], corner[2], corner[3], q);
+    }
+    /// (u, v) of q from a nearby guess: one Newton step on the bilinear map (exact for a
+    /// parallelogram; from a guess off by d, off by about |twist| d^2 after it).
+    Vec2 refine_parameters(Vec2 q, Vec2 guess) const {
+        if (parallelogram) return parameters(q);
+        const Vec2 e = corner[1] - corner[0], f = corner[3] - corner[0];
+        const Vec2 g = corner[0] - corner[1] + corner[2] - corner[3];
+        const double u = guess.x, v = guess.y;
+        const Vec2 r = corner[0] + u * e + v * f + (u * v) * g - q;
+        const Vec2 pu = e + v * g, pv = f + u * g;
+        const double det = cross(pu, pv);
+        if (det == 0) return guess;
+        return {u - cross(r, pv) / det, v - cross(pu, r) / det};
     }
 };
 /// The frame of a planar quad (its corners projected onto their mean plane).
@@ -101,16 +121,25 @@ struct BlockedView {
     std::vector<ConvexPolygon> shadows;  // projected occluders (counter-clockwise)
     bool trivial() const { return !behind_all && !horizon_cuts && shadows.empty(); }
 };
-/// The view from point p (normal n_p). `context` may be null (horizon only).
+/// The view from point p (normal n_p). `context` may be null (horizon only). When p lies on a
+/// planar receiver, `receiver_plane` (may be null) gives its plane: the horizon is then the
+/// same line for every point of the receiver, to the last bit.
 BlockedView blocked_view(const ShooterPlane& plane, Vec3 p, Vec3 n_p,
-                         const OcclusionContext* context);
+                         const OcclusionContext* context, const Plane* receiver_plane = nullptr);
+
+/// The plane of a planar quad (Newell's normal through the corners' mean; only when its corners
+/// lie on it to rounding) or a disk, oriented by its front; nothing for other surfaces.
+std::optional<Plane> surface_plane(const Surface& surface);
 
 /// Drops shadows inside another and merges pairs whose union is convex, until none merges.
 void merge_shadows(std::vector<ConvexPolygon>& shadows);
 
 /// How a shooter cell (its image, a convex quad of the plane) lies in a view.
 enum class CellVisibility { clear, hidden, cut };
-CellVisibility classify_cell(const ConvexPolygon& cell, const BlockedView& view);
+/// The same, also saying whether a shadow takes part in the cut (*shadowed; false when only
+/// the horizon cuts the cell).
+CellVisibility classify_cell(const ConvexPolygon& cell, const BlockedView& view,
+                             bool* shadowed = nullptr);
 /// The visible part of a cut cell as disjoint convex pieces.
 std::vector<ConvexPolygon> visible_pieces(const ConvexPolygon& cell, const BlockedView& view);
 

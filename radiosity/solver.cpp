@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <set>
 
 #include "math/bspline.h"
@@ -92,6 +93,13 @@ SolverOptions solver_options(const SolverSettings& s) {
     // DESIGN: every finest-level coefficient projected on the fine grid (project_fine_grid):
     // adaptive trees then reach the accuracy of uniform ones (docs/method.md, adaptive study).
     o.receiver.unify_by_projection = true;
+    // DESIGN: cost follows energy (measured on the Cornell box, docs/method.md): a receiver
+    // that gets less than 10 absolute tolerances starts its oracle at the root, the shadowed
+    // part's triangles use 3 against 4 points, edgefill stops 2 levels below the finest
+    // boundary leaf.
+    o.receiver.weak_receiver = 10;
+    o.receiver.quadrature.n_pieces = 3;
+    o.receiver.edgefill_max_depth = 2;
     o.receiver.m = s.order;
     o.receiver.min_depth = s.min_depth;
     o.receiver.max_depth = s.max_depth;

@@ -37,7 +37,7 @@ struct SolverOptions {
     bool self_transfer = false;     // concave curved surfaces receive from themselves
     double tolerance = 1e-3;        // accuracy relative to the scene's radiosity scale: the
                                     //   absolute tolerance of every transfer (see file comment)
-    double quadrature_share = 0.1;  // the quadrature's absolute tolerance, as a share of it
+    double quadrature_share = 1;    // the quadrature's absolute tolerance, as a share of it
     int emission_level = 5;         // level at which a textured emission is projected
     bool hidden_regions = true;     // beyond the paper: samples at points that see no front
                                     //   face take the nearest visible point's value

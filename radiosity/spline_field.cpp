@@ -93,6 +93,82 @@ void SplineField::evaluate_grid(const double* s, int n_s, const double* t, int n
     }
 }
 
+PolynomialPatches::PolynomialPatches(const SplineField& field) {
+    if (field.empty()) return;
+    const int m = m_ = field.order();
+    const int level = field.level();
+    cells_ = 1 << level;
+    // The m pieces of N_m as polynomials on [0,1): P_r(x) = N_m(x + r) = sum_p P[r][p] x^p, by
+    // interpolation at m points (exact: each piece has degree m - 1).
+    std::vector<double> P(size_t(m) * m);
+    {
+        std::vector<double> V(size_t(m) * m), rhs(m);
+        for (int r = 0; r < m; ++r) {
+            for (int a = 0; a < m; ++a) {
+                const double x = (a + 0.5) / m;
+                double power = 1;
+                for (int p = 0; p < m; ++p, power *= x) V[size_t(a) * m + p] = power;
+                rhs[a] = bspline(m, x + r);
+            }
+            // Gaussian elimination with partial pivoting on the small Vandermonde system.
+            std::vector<double> A = V, b = rhs;
+            for (int col = 0; col < m; ++col) {
+                int piv = col;
+                for (int row = col + 1; row < m; ++row)
+                    if (std::fabs(A[size_t(row) * m + col]) > std::fabs(A[size_t(piv) * m + col])) piv = row;
+                for (int k = 0; k < m; ++k) std::swap(A[size_t(col) * m + k], A[size_t(piv) * m + k]);
+                std::swap(b[col], b[piv]);
+                for (int row = col + 1; row < m; ++row) {
+                    const double f = A[size_t(row) * m + col] / A[size_t(col) * m + col];
+                    for (int k = col; k < m; ++k) A[size_t(row) * m + k] -= f * A[size_t(col) * m + k];
+                    b[row] -= f * b[col];
+                }
+            }
+            for (int row = m - 1; row >= 0; --row) {
+                double s = b[row];
+                for (int k = row + 1; k < m; ++k) s -= A[size_t(row) * m + k] * P[size_t(r) * m + k];
+                P[size_t(r) * m + row] = s / A[size_t(row) * m + row];
+            }
+        }
+    }
+    // Cell (i, j): basis k = i - r (r = 0 .. m-1) is P_r there; C[p][q] = sum c_{i-r, j-r'}
+    // P[r][p] P[r'][q].
+    c_.assign(size_t(cells_) * cells_ * 3 * m * m, 0.0);
+    for (int j = 0; j < cells_; ++j)
+        for (int i = 0; i < cells_; ++i)
+            for (int ch = 0; ch < 3; ++ch) {
+                double* C = &c_[((size_t(j) * cells_ + i) * 3 + ch) * m * m];
+                for (int r = 0; r < m; ++r)
+                    for (int r2 = 0; r2 < m; ++r2) {
+                        const double a = field.coefficient(i - r, j - r2)[ch];
+                        if (a == 0) continue;
+                        for (int p = 0; p < m; ++p)
+                            for (int q = 0; q < m; ++q)
+                                C[p * m + q] += a * P[size_t(r) * m + p] * P[size_t(r2) * m + q];
+                    }
+            }
+}
+
+Rgb PolynomialPatches::operator()(double s, double t) const {
+    if (c_.empty()) return {};
+    const double x = std::clamp(s, 0.0, 1.0) * cells_, y = std::clamp(t, 0.0, 1.0) * cells_;
+    const int i = std::min(cells_ - 1, static_cast<int>(x)), j = std::min(cells_ - 1, static_cast<int>(y));
+    const double lx = x - i, ly = y - j;
+    const int m = m_;
+    Rgb out;
+    for (int ch = 0; ch < 3; ++ch) {
+        const double* C = &c_[((size_t(j) * cells_ + i) * 3 + ch) * m * m];
+        double value = 0;
+        for (int p = m - 1; p >= 0; --p) {
+            double row = 0;
+            for (int q = m - 1; q >= 0; --q) row = row * ly + C[p * m + q];
+            value = value * lx + row;
+        }
+        out[ch] = value;
+    }
+    return out;
+}
+
 bool SplineField::is_constant() const {
     for (const auto& g : grid_)
         for (double v : g.a)

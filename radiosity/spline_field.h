@@ -9,6 +9,7 @@
 
 #include <array>
 #include <functional>
+#include <vector>
 
 #include "math/bspline.h"
 #include "math/vec3.h"
@@ -61,6 +62,21 @@ private:
     int m_ = 0;
     int level_ = 0;
     std::array<CoefficientGrid, 3> grid_;
+};
+
+/// The same function as a SplineField, stored per level-j knot cell as m x m tensor polynomials
+/// in the cell's own coordinates: for evaluating one field at many scattered points (Horner's
+/// rule instead of the B-spline recursion and m^2 coefficient look-ups of evaluate()).
+class PolynomialPatches {
+public:
+    PolynomialPatches() = default;
+    explicit PolynomialPatches(const SplineField& field);
+    /// f(s, t) for (s, t) clamped to [0,1]^2; equal to SplineField::evaluate up to rounding.
+    Rgb operator()(double s, double t) const;
+
+private:
+    int m_ = 0, cells_ = 0;
+    std::vector<double> c_;  // cell (i, j), channel ch: c_[((j * cells + i) * 3 + ch) * m * m + p * m + q]
 };
 
 }  // namespace mbr

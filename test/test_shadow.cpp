@@ -937,8 +937,8 @@ TEST_CASE("shadow: exact visibility in (21) matches the shadowed form factor", "
     // points of the square and tilted configurations, and of the small shooter (side 0.3) whose
     // occluder casts an umbra on [0.25, 0.75]^2. The rule's tolerance is 1e-4 relative to the
     // unshadowed estimate (floor 1e-4 of max B): |I - exact| <= 1e-4 F_unshadowed at every point.
-    // In the umbra every shooter cell is hidden: I is exactly 0. Both the quadrature over the
-    // visible pieces and the closed form (a constant shooter's default) are checked.
+    // In the umbra nothing is visible: I is 0. Both the quadrature (the whole minus the hidden
+    // part) and the closed form (a constant shooter's default) are checked.
     for (const bool analytic : {false, true}) {
     CAPTURE(analytic);
     QuadratureOptions options;
@@ -976,7 +976,13 @@ TEST_CASE("shadow: exact visibility in (21) matches the shadowed form factor", "
             rays += r.n_rays;
             ++n_points;
             if (std::string(c.name) == "umbra" && s > 0.26 && s < 0.74 && t > 0.26 && t < 0.74) {
-                CHECK(r.value.r == 0);
+                // The closed form sums the visible pieces: none, exactly 0. The quadrature
+                // subtracts the hidden part from the whole (shadow_subtraction): 0 up to
+                // rounding of the two equal integrals.
+                if (analytic)
+                    CHECK(r.value.r == 0);
+                else
+                    CHECK(std::fabs(r.value.r) <= 1e-12 * full);
                 ++n_umbra;
             }
         }
