@@ -89,19 +89,28 @@ double IncrementIntegrator::visible_form_factor(const SurfacePoint& p) {
     // The contour formula of the reference (Baum et al. 1989), piece by piece (each convex,
     // counter-clockwise seen from the shooter's front).
     if (view_.behind_all) return 0;
-    std::vector<ConvexPolygon> pieces;
-    if (view_.trivial())
-        pieces.push_back(plane_.outline);
-    else
-        pieces = visible_pieces(plane_.outline, view_);
-    double F = 0;
     std::vector<Vec3> polygon;
-    for (const ConvexPolygon& piece : pieces) {
+    auto lambert = [&](const ConvexPolygon& piece) {
         polygon.clear();
         for (const Vec2& q : piece) polygon.push_back(plane_.to_space(q));
-        F += point_polygon_form_factor(p.position, p.normal, polygon);
+        return point_polygon_form_factor(p.position, p.normal, polygon);
+    };
+    if (!options_.shadow_subtraction) {  // the visible pieces themselves
+        double F = 0;
+        for (const ConvexPolygon& piece : visible_pieces(plane_.outline, view_)) F += lambert(piece);
+        return F;
     }
-    return F;
+    // The front part of the outline minus the disjoint parts of the shadows: two or three
+    // polygons instead of the pieces the shadows would cut the outline into.
+    take_shadows_apart();
+    const ConvexPolygon front = view_.horizon_cuts ? clip(plane_.outline, view_.front) : plane_.outline;
+    double hidden_area = 0;
+    for (const ConvexPolygon& region : shadow_regions_) hidden_area += signed_area(region);
+    // An umbra: the shadows cover all of it (the regions are disjoint parts of it), exactly 0.
+    if (hidden_area >= (1 - 1e-12) * signed_area(front)) return 0;
+    double F = lambert(front);
+    for (const ConvexPolygon& region : shadow_regions_) F -= lambert(region);
+    return std::max(F, 0.0);
 }
 
 IncrementIntegrator::PointSpan IncrementIntegrator::points(const QuadCell& cell, int n) {
@@ -275,7 +284,8 @@ Rgb IncrementIntegrator::shadow_on(const SurfacePoint& p, const std::vector<Shad
 
 void IncrementIntegrator::take_shadows_apart() {
     // Disjoint convex parts of the union of the shadows (each minus the earlier ones), clipped
-    // to the front of the horizon; the cells then see the horizon alone.
+    // to the front of the horizon; the cells then see the horizon alone. (Once per view: a
+    // second call finds no shadows left.)
     for (size_t s = 0; s < view_.shadows.size(); ++s) {
         std::vector<ConvexPolygon> parts{view_.horizon_cuts ? clip(view_.shadows[s], view_.front) : view_.shadows[s]};
         for (size_t t = 0; t < s && !parts.empty(); ++t) {
@@ -459,8 +469,8 @@ IncrementIntegrator::Result IncrementIntegrator::integrate(const SurfacePoint& p
     // its own, its fan triangles split uniformly until two depths agree within half the
     // tolerance, and subtracted. The rule over the cells gets the other half.
     Rgb shadowed;
-    if (planar_ && options_.shadow_subtraction && !view_.shadows.empty()) {
-        take_shadows_apart();
+    if (planar_ && options_.shadow_subtraction) take_shadows_apart();
+    if (!shadow_regions_.empty()) {
         const double share = 0.5 * opt.tolerance;
         opt.tolerance -= share;
         shadowed = shadow_integral(p, share, near_field, &result.shadow_triangles);
@@ -516,7 +526,7 @@ Rgb IncrementIntegrator::integrate_on(const SurfacePoint& p,
         b_star_ = made_by->subtracted;
         sum = visible_form_factor(p) * b_star_;
     }
-    if (made_by && made_by->shadow_subtracted && !view_.shadows.empty()) {
+    if (made_by && made_by->shadow_subtracted) {
         // The shadowed part on the triangles the partition's point kept: the same refinement
         // at both points, so a divided difference (22) of them stays smooth.
         take_shadows_apart();

@@ -188,6 +188,7 @@ ProgressiveSolver::ProgressiveSolver(const Scene& scene, const Octree& octree,
     solution_.leaves.resize(n);
     split_cells_.resize(n);
     coupling_.resize(n);
+    last_seconds_.assign(n, 0.0);
     weights_.resize(n);
     hidden_.resize(n);
     if (options.hidden_regions)
@@ -345,8 +346,16 @@ ShotStats ProgressiveSolver::shoot() {
         // One transfer at a time, each parallel inside (stage 7 needs its fractions in parallel).
         for (int k = 0; k < n_rec; ++k) run_one(k);
     } else {
-        parallel_for(n_rec, run_one);
+        // The receivers that took longest last time first, so that no thread is left with one
+        // big transfer at the end (the results do not depend on the order).
+        std::vector<int> order(n_rec);
+        for (int k = 0; k < n_rec; ++k) order[k] = k;
+        std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
+            return last_seconds_[receivers[a]] > last_seconds_[receivers[b]];
+        });
+        parallel_for(n_rec, [&](int k) { run_one(order[k]); });
     }
+    for (int k = 0; k < n_rec; ++k) last_seconds_[receivers[k]] = results[k].stats.seconds_total;
 
     // Superposition in receiver order: B_i += dB_i, B_unshot_i += dB_i; then B_unshot_h = 0.
     const Rgb shot_power = power(h, shooter.unshot);

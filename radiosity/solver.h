@@ -135,6 +135,7 @@ private:
     const std::vector<double>& power_weights(int surface, int level) const;
     mutable std::vector<std::vector<std::vector<double>>> weights_;
     std::vector<HiddenMask> hidden_;  // per surface (empty masks when the option is off)
+    std::vector<double> last_seconds_;  // per surface: its last transfer's seconds (scheduling)
     Rgb power(int surface, const SplineField& field) const;
 };
 
