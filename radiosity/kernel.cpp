@@ -78,13 +78,6 @@ IncrementIntegrator::IncrementIntegrator(const Shooter& shooter, const Quadratur
     if (planar_ && !unshot_constant_) unshot_patches_ = PolynomialPatches(shooter.unshot);
 }
 
-Rgb IncrementIntegrator::analytic_value(const SurfacePoint& p) {
-    // Eq. (21) for a constant B_h over a planar polygon: B_h times the form factor from p to
-    // the part of the shooter p sees.
-    set_view(p);
-    return visible_form_factor(p) * shooter_.unshot.coefficient(0, 0);
-}
-
 double IncrementIntegrator::visible_form_factor(const SurfacePoint& p) {
     // The contour formula of the reference (Baum et al. 1989), piece by piece (each convex,
     // counter-clockwise seen from the shooter's front).
@@ -391,7 +384,8 @@ IncrementIntegrator::PointSpan IncrementIntegrator::horizon_points(const QuadCel
 }
 
 Rgb IncrementIntegrator::cell_value(const SurfacePoint& p, const QuadCell& cell, int n) {
-    if (planar_ && !view_.trivial()) {
+    const bool rays = !planar_ || view_.use_rays;  // visibility by one ray per node
+    if (planar_ && !view_.trivial() && !view_.use_rays) {
         const ConvexPolygon image = cell_image(cell);
         bool shadowed = false;
         switch (classify_cell(image, view_, &shadowed)) {
@@ -412,16 +406,53 @@ Rgb IncrementIntegrator::cell_value(const SurfacePoint& p, const QuadCell& cell,
             }
         }
     }
-    if (!occlusion_ || planar_) return sum_over(p, points(cell, n));
-    // A curved shooter with occluders: one visibility ray per node (eq. (21) with VIS).
+    if (!occlusion_ || !rays) return sum_over(p, points(cell, n));
+    // A curved shooter, or too many occluders to project: one visibility ray per node (eq. (21)
+    // with VIS), tested against the occluders that can come between p and this cell (a
+    // polygon whose box misses the box of p and the cell, or whose plane has them all on one
+    // side, cannot); none: no rays at all.
     const PointSpan pts = points(cell, n);
+    Box3 shaft;
+    shaft.extend(p.position);
+    for (int i = 0; i < pts.count; ++i) shaft.extend(pts.first[i].x);
+    const Rect& r = cell.rect;
+    for (const Vec2 c : {Vec2{r.x0, r.y0}, Vec2{r.x1, r.y0}, Vec2{r.x0, r.y1}, Vec2{r.x1, r.y1}})
+        shaft.extend(shooter_.surface->point(c.x, c.y));
+    const std::vector<Polygon>& polys = occlusion_->octree->polygons();
+    const std::vector<int>& list = view_.use_rays ? view_.occluders : occlusion_->candidates;
+    local_.clear();
+    for (int id : list) {
+        const Polygon& poly = polys[id];
+        if (!overlaps(poly.bounds(), shaft)) continue;
+        const Plane& pl = poly.plane();
+        double lo = HUGE_VAL, hi = -HUGE_VAL;
+        for (int corner = 0; corner < 8; ++corner) {
+            const Vec3 c{(corner & 1) ? shaft.hi.x : shaft.lo.x, (corner & 2) ? shaft.hi.y : shaft.lo.y,
+                         (corner & 4) ? shaft.hi.z : shaft.lo.z};
+            const double d = pl.signed_distance(c);
+            lo = std::min(lo, d);
+            hi = std::max(hi, d);
+        }
+        if (lo > 0 || hi < 0) continue;
+        local_.push_back(id);
+    }
+    if (local_.empty()) return sum_over(p, pts);
     Rgb sum;
     int n_visible = 0, n_blocked = 0;
     for (int i = 0; i < pts.count; ++i) {
         const ShooterPoint& q = pts.first[i];
         const double F = form_factor_kernel(p.position, p.normal, q.x, q.n);
         if (F == 0) continue;
-        if (segment_blocked(*occlusion_, p.position, q.x, &rays_)) {
+        ++rays_;
+        // DESIGN: the open segment, as segment_blocked: t in [1e-9, 1 - 1e-9].
+        const Ray ray{p.position, q.x - p.position, 1e-9, 1 - 1e-9};
+        bool blocked = false;
+        for (int id : local_)
+            if (polys[id].intersect(ray)) {
+                blocked = true;
+                break;
+            }
+        if (blocked) {
             ++n_blocked;
             continue;
         }
@@ -437,8 +468,12 @@ IncrementIntegrator::Result IncrementIntegrator::integrate(const SurfacePoint& p
                                                            bool allow_subtraction) {
     Result result;
     if (analytic_ && !keep_partition) {
-        result.value = analytic_value(p);
-        return result;
+        set_view(p);
+        if (!view_.use_rays) {  // eq. (21) for a constant B_h: B_h times the form factor to
+                                // the part of the shooter p sees (exact visibility)
+            result.value = visible_form_factor(p) * shooter_.unshot.coefficient(0, 0);
+            return result;
+        }
     }
     set_view(p);
     if (view_.behind_all) return result;  // the whole shooter is behind p: nothing arrives
@@ -453,7 +488,7 @@ IncrementIntegrator::Result IncrementIntegrator::integrate(const SurfacePoint& p
     // x* of p carries the peak of F exactly; the rule integrates F (B_h - B_h(x*)).
     double near_field = options_.near_field;
     Rgb exact_part;
-    if (planar_ && !unshot_constant_ && options_.subtract && allow_subtraction) {
+    if (planar_ && !unshot_constant_ && options_.subtract && allow_subtraction && !view_.use_rays) {
         const Vec2 uv = plane_.parameters(plane_.to_plane(p.position));
         const Rgb b_star = shooter_.unshot.evaluate(std::clamp(uv.x, 0.0, 1.0), std::clamp(uv.y, 0.0, 1.0));
         exact_part = visible_form_factor(p) * b_star;
@@ -479,7 +514,8 @@ IncrementIntegrator::Result IncrementIntegrator::integrate(const SurfacePoint& p
     opt.max_depth = options_.max_depth;
     // Per-node visibility on a curved shooter: a visibility step never passes the n against
     // n + 1 test, so without this cap its cells would split down to max_depth.
-    if (occlusion_ && !planar_) opt.max_depth = std::min(opt.max_depth, options_.max_visibility_depth);
+    const bool ray_visibility = occlusion_ && (!planar_ || view_.use_rays);
+    if (ray_visibility) opt.max_depth = std::min(opt.max_depth, options_.max_visibility_depth);
     opt.min_depth = min_depth >= 0 ? std::min(min_depth, options_.max_depth) : options_.min_depth;
     opt.min_share = options_.min_share;
     opt.global = options_.global;
@@ -493,7 +529,7 @@ IncrementIntegrator::Result IncrementIntegrator::integrate(const SurfacePoint& p
     // extent at most near_field times their distance from p.
     auto near = [&](const QuadCell& cell) {
         if (!mixed_.empty() && std::find(mixed_.begin(), mixed_.end(), cell_key(cell)) != mixed_.end() &&
-            (planar_ || cell.level < options_.max_visibility_depth))
+            (!ray_visibility || cell.level < options_.max_visibility_depth))
             return true;  // its nodes disagree on visibility, or a coarse cut cell: split
         if (near_field <= 0) return false;
         // The cell's extent: its nodes and its corners (the nodes alone leave a gap along the

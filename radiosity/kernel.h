@@ -182,7 +182,6 @@ private:
     /// a curved shooter with an occlusion context.
     Rgb cell_value(const SurfacePoint& p, const QuadCell& cell, int n);
     void set_view(const SurfacePoint& p);
-    Rgb analytic_value(const SurfacePoint& p);
     ConvexPolygon cell_image(const QuadCell& cell) const;
     Rgb pieces_value(const SurfacePoint& p, const std::vector<ConvexPolygon>& pieces, int n);
     Rgb triangle_value(const SurfacePoint& p, Vec2 a, Vec2 b, Vec2 c, int n);
@@ -206,6 +205,7 @@ private:
     long extra_evaluations_ = 0;        // kernel evaluations on cut pieces (current point)
     long rays_ = 0;                     // rays cast for the current point
     Rgb b_star_;                        // the constant subtracted from B_h (zero: none)
+    std::vector<int> local_;            // scratch: the occluders of one cell's shaft
     std::vector<std::uint64_t> mixed_;  // cells whose nodes disagreed on visibility (curved), or
                                         //   cut cells above min_cut_level (planar): split
     std::uint64_t pieces_key_ = ~0ULL;  // the cut cell whose pieces are in pieces_

@@ -54,6 +54,13 @@ struct SolverSettings {
     double convergence = 1e-3;             // stop when unshot power < this x emitted power
     bool self_transfer = false;            // may a concave curved surface light itself
     int tessellation = 16;                 // facets per parameter direction for ray casting
+    std::string shadows = "exact";         // "exact" (visibility inside (21)), "paper"
+                                           //   (fractions (28) and masking) or "none"
+    double tolerance = 1e-3;               // accuracy relative to the scene's radiosity scale
+    std::string unify = "projection";      // "projection" (every finest coefficient on the fine
+                                           //   grid) or "paper" ((17) from selected fulcrums)
+    bool ambient = true;                   // ambient correction of the unshot power at the end
+    bool hidden = true;                    // hidden regions take their visible neighbours' values
 };
 
 /// A whole scene. Surface i's material is materials[surfaces[i].material].

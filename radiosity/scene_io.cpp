@@ -1353,11 +1353,25 @@ private:
             s.self_transfer = value == "true";
         } else if (key == "tessellation") {
             s.tessellation = integer(1, 1024);
+        } else if (key == "shadows") {
+            if (value != "exact" && value != "paper" && value != "none")
+                line.fail("shadows " + in_quotes(value) + " is not 'exact', 'paper' or 'none'");
+            s.shadows = value;
+        } else if (key == "tolerance") {
+            s.tolerance = real(0, 1, true, true);
+        } else if (key == "unify") {
+            if (value != "projection" && value != "paper")
+                line.fail("unify " + in_quotes(value) + " is neither 'projection' nor 'paper'");
+            s.unify = value;
+        } else if (key == "ambient" || key == "hidden") {
+            if (value != "true" && value != "false")
+                line.fail(key + " " + in_quotes(value) + " is neither 'true' nor 'false'");
+            (key == "ambient" ? s.ambient : s.hidden) = value == "true";
         } else {
             line.fail("unknown setting " + in_quotes(key) +
                       " (known: order, min_depth, max_depth, oracle_tolerance, truncation_eps, "
                       "rhombus_radius, extrapolation, shadow_rays, max_shots, convergence, "
-                      "self_transfer, tessellation)");
+                      "self_transfer, tessellation, shadows, tolerance, unify, ambient, hidden)");
         }
     }
 

@@ -247,7 +247,60 @@ BlockedView blocked_view(const ShooterPlane& plane, Vec3 p, Vec3 n_p,
     const double h_p = dot(plane.normal, p - plane.origin);  // height of p above the plane
     if (!context || context->candidates.empty() || h_p <= 0) return view;
     const std::vector<Polygon>& polys = context->octree->polygons();
-    for (int id : context->candidates) {
+    // Many occluders for the pair (a big scene): only those that meet the pyramid from p to the
+    // shooter count for p, found with the octree; still too many: rays instead of projection.
+    std::vector<int> near_p;
+    const std::vector<int>* occluders = &context->candidates;
+    if (static_cast<int>(context->candidates.size()) > context->exact_limit) {
+        struct Side {
+            Vec3 n;
+            double d;
+        };
+        std::vector<Side> sides;
+        const int nc = static_cast<int>(plane.outline.size());
+        double scale = length(p);
+        for (int i = 0; i < nc; ++i) {
+            const Vec3 a = plane.to_space(plane.outline[i]), b = plane.to_space(plane.outline[(i + 1) % nc]);
+            scale = std::max(scale, length(a));
+            Vec3 n = normalize(cross(b - a, p - a));
+            if (dot(n, plane.to_space(plane.outline[(i + 2) % nc]) - a) > 0) n = -1.0 * n;
+            sides.push_back({n, dot(n, a)});
+        }
+        sides.push_back({-1.0 * plane.normal, -dot(plane.normal, plane.origin)});  // beyond the shooter
+        const double tol = 1e-9 * scale;
+        auto outside_box = [&](const Box3& box) {
+            for (const Side& s : sides) {
+                const Vec3 inner{s.n.x > 0 ? box.lo.x : box.hi.x, s.n.y > 0 ? box.lo.y : box.hi.y,
+                                 s.n.z > 0 ? box.lo.z : box.hi.z};
+                if (dot(s.n, inner) - s.d > tol) return true;
+            }
+            return false;
+        };
+        for (int id : context->octree->polygons_near([&](const Box3& b) { return !outside_box(b); })) {
+            if (!std::binary_search(context->candidates.begin(), context->candidates.end(), id)) continue;
+            bool out = false;
+            for (const Side& s : sides) {
+                bool all = true;
+                for (const Vec3& v : polys[id].vertices())
+                    if (dot(s.n, v) - s.d <= tol) {
+                        all = false;
+                        break;
+                    }
+                if (all) {
+                    out = true;
+                    break;
+                }
+            }
+            if (!out) near_p.push_back(id);
+        }
+        if (static_cast<int>(near_p.size()) > context->exact_limit) {
+            view.use_rays = true;
+            view.occluders = std::move(near_p);
+            return view;
+        }
+        occluders = &near_p;
+    }
+    for (int id : *occluders) {
         // Keep the part of the occluder strictly between the plane and p (0 <= h < h_p), then
         // project it from p: x -> p + h_p / (h_p - h(x)) (x - p).
         const std::vector<Vec3>& vs = polys[id].vertices();

@@ -56,6 +56,8 @@ struct OcclusionContext {
     int receiver_surface = -1;
     std::vector<int> candidates;  // polygon indices, increasing
     std::uint64_t seed = 0;       // of every ray of the transfer: the pair and the shot number
+    int exact_limit = 24;         // exact visibility projects at most this many occluders for
+                                  //   one receiving point; beyond, one ray per quadrature node
     /// True when nothing can come between the two surfaces.
     bool clear() const { return candidates.empty(); }
 };
@@ -119,7 +121,10 @@ struct BlockedView {
     bool horizon_cuts = false;           // the horizon line crosses the shooter
     HalfPlane front;                     // the visible side of the horizon line
     std::vector<ConvexPolygon> shadows;  // projected occluders (counter-clockwise)
-    bool trivial() const { return !behind_all && !horizon_cuts && shadows.empty(); }
+    bool use_rays = false;               // too many occluders for projection (exact_limit):
+                                         //   visibility by one ray per quadrature node
+    std::vector<int> occluders;          // then: the occluders that meet p's pyramid
+    bool trivial() const { return !behind_all && !horizon_cuts && shadows.empty() && !use_rays; }
 };
 /// The view from point p (normal n_p). `context` may be null (horizon only). When p lies on a
 /// planar receiver, `receiver_plane` (may be null) gives its plane: the horizon is then the

@@ -92,7 +92,7 @@ SolverOptions solver_options(const SolverSettings& s) {
     o.receiver.quadrature.n = 4;
     // DESIGN: every finest-level coefficient projected on the fine grid (project_fine_grid):
     // adaptive trees then reach the accuracy of uniform ones (docs/method.md, adaptive study).
-    o.receiver.unify_by_projection = true;
+    o.receiver.unify_by_projection = s.unify == "projection";
     // DESIGN: cost follows energy (measured on the Cornell box, docs/method.md): a receiver
     // that gets less than 10 absolute tolerances starts its oracle at the root, the shadowed
     // part's triangles use 3 against 4 points, edgefill stops 2 levels below the finest
@@ -109,9 +109,15 @@ SolverOptions solver_options(const SolverSettings& s) {
     o.receiver.extrapolation =
         s.extrapolation == "linear" ? Extrapolation::Linear : Extrapolation::Quadratic;
     o.receiver.shadows.rays_per_patch = s.shadow_rays;
+    o.receiver.shadows.method = s.shadows == "exact"   ? ShadowMethod::Exact
+                                : s.shadows == "paper" ? ShadowMethod::Fractions
+                                                       : ShadowMethod::None;
     o.max_shots = s.max_shots;
     o.convergence = s.convergence;
     o.self_transfer = s.self_transfer;
+    o.tolerance = s.tolerance;
+    o.ambient = s.ambient;
+    o.hidden_regions = s.hidden;
     return o;
 }
 
@@ -312,6 +318,7 @@ ShotStats ProgressiveSolver::shoot() {
     ReceiverOptions ro = options_.receiver;
     ro.absolute_tolerance = options_.tolerance * radiosity_scale_;
     ro.quadrature.abs_tolerance = options_.quadrature_share * ro.absolute_tolerance;
+    if (const char* e = std::getenv("MBR_VISD")) ro.quadrature.max_visibility_depth = std::atoi(e);  // EXPERIMENT
     const SplineField& unshot_h = solution_.unshot[h];
     const int coarsen = std::max(ro.shooter_coarsening, unshot_h.level() - options_.shooter_level);
     const Shooter shooter = make_shooter(shooter_surface, unshot_h, coarsen);

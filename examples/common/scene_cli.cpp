@@ -28,14 +28,18 @@ const char* solver_options_usage =
     "  --shots n                 at most n shots, 0..10000000 (scene's max_shots, default 100)\n"
     "  --convergence c           stop when the largest unshot power is below c x emitted, [0, 1)\n"
     "  --tolerance x             accuracy relative to the scene's radiosity scale, (0, 1)\n"
-    "                            (default 1e-3): sets every transfer's absolute tolerance\n"
-    "  --shadows M               exact (visibility inside (21), default), paper (fractions\n"
-    "                            (28) and masking) or none\n"
+    "                            (scene's `set tolerance`, default 1e-3): sets every\n"
+    "                            transfer's absolute tolerance\n"
+    "  --shadows M               exact (visibility inside (21), default), paper\n"
+    "                            (fractions (28) and masking) or none (`set shadows`)\n"
     "  --rays R                  paper shadows: rays per shooter patch, 1..4096\n"
     "  --unify projection|paper  every finest coefficient projected on the fine grid\n"
     "                            (default), or the paper's (17) from selected fulcrums\n"
-    "  --ambient on|off          the ambient correction of the unshot power (default on)\n"
-    "  --hidden on|off           hidden regions take their visible neighbours' values (on)\n"
+    "                            (`set unify`)\n"
+    "  --ambient on|off          the ambient correction of the unshot power (`set ambient`,\n"
+    "                            default on)\n"
+    "  --hidden on|off           hidden regions take their visible neighbours' values\n"
+    "                            (`set hidden`, default on)\n"
     "  --threads n               OpenMP threads, 1..256 (default: all cores)\n"
     "  --quiet                   no progress bar\n";
 
@@ -57,7 +61,7 @@ SceneRun read_scene_run(Args& args, const std::string& default_scene) {
     const int max_depth = args.integer("--max-depth", -1);
     const int shots = args.integer("--shots", -1);
     const double convergence = args.number("--convergence", -1);
-    const double tolerance = args.number("--tolerance", 1e-3);
+    const double tolerance = args.number("--tolerance", -1);
     const std::string shadows = args.text("--shadows", "exact");
     const int rays = args.integer("--rays", -1);
     const std::string unify = args.text("--unify", "projection");
@@ -76,7 +80,7 @@ SceneRun read_scene_run(Args& args, const std::string& default_scene) {
     if (args.has("--max-depth")) in_range("--max-depth", max_depth, 0, 12);
     if (args.has("--shots")) in_range("--shots", shots, 0, 1e7);
     if (args.has("--convergence")) in_range("--convergence", convergence, 0, 1, false, true);
-    in_range("--tolerance", tolerance, 0, 1, true, true);
+    if (args.has("--tolerance")) in_range("--tolerance", tolerance, 0, 1, true, true);
     if (args.has("--rays")) in_range("--rays", rays, 1, 4096);
     if (args.has("--threads")) in_range("--threads", run.threads, 1, 256);
     if (shadows != "exact" && shadows != "paper" && shadows != "none")
@@ -103,14 +107,15 @@ SceneRun read_scene_run(Args& args, const std::string& default_scene) {
     }
     if (shots >= 0) o.max_shots = shots;
     if (convergence >= 0) o.convergence = convergence;
-    o.tolerance = tolerance;
-    o.receiver.shadows.method = shadows == "exact"   ? ShadowMethod::Exact
-                                : shadows == "paper" ? ShadowMethod::Fractions
-                                                     : ShadowMethod::None;
+    if (args.has("--tolerance")) o.tolerance = tolerance;
+    if (args.has("--shadows"))
+        o.receiver.shadows.method = shadows == "exact"   ? ShadowMethod::Exact
+                                    : shadows == "paper" ? ShadowMethod::Fractions
+                                                         : ShadowMethod::None;
     if (rays > 0) o.receiver.shadows.rays_per_patch = rays;
-    o.ambient = ambient == "on";
-    o.receiver.unify_by_projection = unify == "projection";
-    o.hidden_regions = hidden == "on";
+    if (args.has("--ambient")) o.ambient = ambient == "on";
+    if (args.has("--unify")) o.receiver.unify_by_projection = unify == "projection";
+    if (args.has("--hidden")) o.hidden_regions = hidden == "on";
 #ifdef _OPENMP
     if (run.threads > 0) omp_set_num_threads(run.threads);
 #endif
