@@ -318,7 +318,6 @@ ShotStats ProgressiveSolver::shoot() {
     ReceiverOptions ro = options_.receiver;
     ro.absolute_tolerance = options_.tolerance * radiosity_scale_;
     ro.quadrature.abs_tolerance = options_.quadrature_share * ro.absolute_tolerance;
-    if (const char* e = std::getenv("MBR_VISD")) ro.quadrature.max_visibility_depth = std::atoi(e);  // EXPERIMENT
     const SplineField& unshot_h = solution_.unshot[h];
     const int coarsen = std::max(ro.shooter_coarsening, unshot_h.level() - options_.shooter_level);
     const Shooter shooter = make_shooter(shooter_surface, unshot_h, coarsen);

@@ -276,8 +276,11 @@ std::vector<Facet> Surface::tessellate(int resolution) const {
     // to a line or a doubled flat strip (a whole cylinder at resolution 1 had no facets at all).
     const bool angular_u = kind_ == Kind::Cylinder || kind_ == Kind::Sphere;
     const bool angular_v = kind_ == Kind::Sphere || kind_ == Kind::Disk;
-    const int n_u = angular_u ? std::max(resolution, 3) : resolution;
-    const int n_v = angular_v ? std::max(resolution, 3) : resolution;
+    // A straight direction (a cylinder's height, a disk's radius) needs one facet: the facets
+    // are exact along it, and every extra one is a polygon more for every ray and shadow.
+    const bool straight_u = kind_ == Kind::Disk, straight_v = kind_ == Kind::Cylinder;
+    const int n_u = straight_u ? 1 : (angular_u ? std::max(resolution, 3) : resolution);
+    const int n_v = straight_v ? 1 : (angular_v ? std::max(resolution, 3) : resolution);
     for (int i = 0; i < n_u; ++i)
         for (int j = 0; j < n_v; ++j) {
             Vec2 q[4] = {{double(i) / n_u, double(j) / n_v},

@@ -68,9 +68,10 @@ public:
     double area() const;
     /// A box containing the whole surface.
     Box3 bounds() const;
-    /// Planar facets covering the surface; `resolution` facets along each parameter direction
-    /// for curved surfaces, at least 3 along an angle (planar quads are always one facet;
-    /// bilinear patches give two triangles per cell because their cells are not planar).
+    /// Planar facets covering the surface; `resolution` facets along each curved parameter
+    /// direction, at least 3 along an angle, one along a straight one (a cylinder's height, a
+    /// disk's radius), where the facets are exact. Planar quads are always one facet; bilinear
+    /// patches give two triangles per cell because their cells are not planar.
     std::vector<Facet> tessellate(int resolution) const;
     /// The four corners for quads, in (0,0), (1,0), (1,1), (0,1) order.
     const Vec3* corners() const { return p_; }

@@ -359,10 +359,11 @@ TEST_CASE("scene_octree: facets Polygon refuses are split or dropped, never fata
         // At 17,000 km rounding of the coordinates (2e-9) beats Polygon's planarity tolerance
         // (1e-6 of a 5e-5 facet): quads are split, many triangles are dropped.
         {"small very far sphere", Surface::sphere(very_far, y, x, 1e-3, 0, Pi, 0, 2 * Pi), false},
-        // Annuli 170 km out: 1e-9 wide, long thin quads Polygon still takes; 1e-11 wide, below
-        // the rounding of the coordinates (1.5e-11), slivers with nothing to keep.
+        // Annuli 170 km out (one facet across the radius): 1e-9 wide, long thin quads Polygon
+        // still takes; 1e-13 wide, below the rounding of the coordinates (1.5e-11), slivers
+        // with nothing to keep.
         {"thin annulus", Surface::disk(far, y, x, 1, 1 + 1e-9, 0, 2 * Pi), true},
-        {"sliver annulus", Surface::disk(far, y, x, 1, 1 + 1e-11, 0, 2 * Pi), false},
+        {"sliver annulus", Surface::disk(far, y, x, 1, 1 + 1e-13, 0, 2 * Pi), false},
     };
     Scene scene;
     for (const Case& c : cases) scene.surfaces.push_back({c.name, c.surface, 0});
