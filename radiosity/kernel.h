@@ -167,6 +167,8 @@ public:
         int count;
     };
     PointSpan points(const QuadCell& cell, int n);
+    /// The shooter's plane when it is a planar quad, else null.
+    const ShooterPlane* shooter_plane() const { return planar_ ? &plane_ : nullptr; }
     /// True when integrate() uses the closed form (QuadratureOptions::analytic).
     bool analytic() const { return analytic_; }
     /// Every receiving point lies on this plane (a planar receiver): the horizon is one line,

@@ -165,6 +165,19 @@ bool segment_blocked(const OcclusionContext& context, Vec3 a, Vec3 b, long* n_ra
                                    RayFilter{context.shooter_surface, context.receiver_surface});
 }
 
+bool segment_blocked(const OcclusionContext& context, const std::vector<int>& occluders, Vec3 a,
+                     Vec3 b, long* n_rays) {
+    if (occluders.empty()) return false;
+    // DESIGN: up to 32 occluders are tested one by one; beyond, the octree is faster.
+    if (occluders.size() > 32) return segment_blocked(context, a, b, n_rays);
+    if (n_rays) ++*n_rays;
+    const Ray ray{a, b - a, 1e-9, 1 - 1e-9};
+    const std::vector<Polygon>& polys = context.octree->polygons();
+    for (int id : occluders)
+        if (polys[id].intersect(ray)) return true;
+    return false;
+}
+
 // ---- The visible part of a planar shooter ------------------------------------------------
 
 Vec2 ShooterPlane::at(double u, double v) const {
@@ -222,6 +235,63 @@ std::optional<Plane> surface_plane(const Surface& surface) {
     return std::nullopt;
 }
 
+std::vector<int> occluders_toward(const OcclusionContext& context, const ShooterPlane& plane,
+                                  Vec3 p) {
+    // The pyramid: a plane through p and each edge of the shooter's outline, and the shooter's
+    // own plane (nothing beyond the shooter blocks a segment that ends on it).
+    struct Side {
+        Vec3 n;
+        double d;
+    };
+    std::vector<Side> sides;
+    const int nc = static_cast<int>(plane.outline.size());
+    double scale = length(p);
+    for (int i = 0; i < nc; ++i) {
+        const Vec3 a = plane.to_space(plane.outline[i]),
+                   b = plane.to_space(plane.outline[(i + 1) % nc]);
+        scale = std::max(scale, length(a));
+        Vec3 n = normalize(cross(b - a, p - a));
+        if (dot(n, plane.to_space(plane.outline[(i + 2) % nc]) - a) > 0) n = -1.0 * n;
+        sides.push_back({n, dot(n, a)});
+    }
+    sides.push_back({-1.0 * plane.normal, -dot(plane.normal, plane.origin)});
+    // DESIGN: a polygon or box within 1e-9 of the coordinates' size of the pyramid is kept.
+    const double tol = 1e-9 * scale;
+    auto outside_box = [&](const Box3& box) {
+        for (const Side& s : sides) {
+            const Vec3 inner{s.n.x > 0 ? box.lo.x : box.hi.x, s.n.y > 0 ? box.lo.y : box.hi.y,
+                             s.n.z > 0 ? box.lo.z : box.hi.z};
+            if (dot(s.n, inner) - s.d > tol) return true;
+        }
+        return false;
+    };
+    const std::vector<Polygon>& polys = context.octree->polygons();
+    auto outside_polygon = [&](int id) {
+        for (const Side& s : sides) {
+            bool all = true;
+            for (const Vec3& v : polys[id].vertices())
+                if (dot(s.n, v) - s.d <= tol) {
+                    all = false;
+                    break;
+                }
+            if (all) return true;
+        }
+        return false;
+    };
+    std::vector<int> out;
+    if (static_cast<int>(context.candidates.size()) <= context.exact_limit) {
+        for (int id : context.candidates)
+            if (!outside_polygon(id)) out.push_back(id);
+        return out;
+    }
+    for (int id : context.octree->polygons_near([&](const Box3& b) { return !outside_box(b); }))
+        if (std::binary_search(context.candidates.begin(), context.candidates.end(), id) &&
+            !outside_polygon(id))
+            out.push_back(id);
+    std::sort(out.begin(), out.end());
+    return out;
+}
+
 BlockedView blocked_view(const ShooterPlane& plane, Vec3 p, Vec3 n_p,
                          const OcclusionContext* context, const Plane* receiver_plane) {
     BlockedView view;
@@ -252,47 +322,7 @@ BlockedView blocked_view(const ShooterPlane& plane, Vec3 p, Vec3 n_p,
     std::vector<int> near_p;
     const std::vector<int>* occluders = &context->candidates;
     if (static_cast<int>(context->candidates.size()) > context->exact_limit) {
-        struct Side {
-            Vec3 n;
-            double d;
-        };
-        std::vector<Side> sides;
-        const int nc = static_cast<int>(plane.outline.size());
-        double scale = length(p);
-        for (int i = 0; i < nc; ++i) {
-            const Vec3 a = plane.to_space(plane.outline[i]), b = plane.to_space(plane.outline[(i + 1) % nc]);
-            scale = std::max(scale, length(a));
-            Vec3 n = normalize(cross(b - a, p - a));
-            if (dot(n, plane.to_space(plane.outline[(i + 2) % nc]) - a) > 0) n = -1.0 * n;
-            sides.push_back({n, dot(n, a)});
-        }
-        sides.push_back({-1.0 * plane.normal, -dot(plane.normal, plane.origin)});  // beyond the shooter
-        const double tol = 1e-9 * scale;
-        auto outside_box = [&](const Box3& box) {
-            for (const Side& s : sides) {
-                const Vec3 inner{s.n.x > 0 ? box.lo.x : box.hi.x, s.n.y > 0 ? box.lo.y : box.hi.y,
-                                 s.n.z > 0 ? box.lo.z : box.hi.z};
-                if (dot(s.n, inner) - s.d > tol) return true;
-            }
-            return false;
-        };
-        for (int id : context->octree->polygons_near([&](const Box3& b) { return !outside_box(b); })) {
-            if (!std::binary_search(context->candidates.begin(), context->candidates.end(), id)) continue;
-            bool out = false;
-            for (const Side& s : sides) {
-                bool all = true;
-                for (const Vec3& v : polys[id].vertices())
-                    if (dot(s.n, v) - s.d <= tol) {
-                        all = false;
-                        break;
-                    }
-                if (all) {
-                    out = true;
-                    break;
-                }
-            }
-            if (!out) near_p.push_back(id);
-        }
+        near_p = occluders_toward(*context, plane, p);
         if (static_cast<int>(near_p.size()) > context->exact_limit) {
             view.use_rays = true;
             view.occluders = std::move(near_p);

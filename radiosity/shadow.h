@@ -76,6 +76,10 @@ OcclusionContext make_occlusion_context(const Octree& octree, const Surface& sho
 /// the candidates when they are few, else the octree with the pair's own surfaces skipped; the
 /// answer is the same). Counts the ray in *n_rays.
 bool segment_blocked(const OcclusionContext& context, Vec3 a, Vec3 b, long* n_rays);
+/// The same against a subset of the candidates known to hold every polygon that can meet the
+/// segment (occluders_toward); an empty subset casts no ray.
+bool segment_blocked(const OcclusionContext& context, const std::vector<int>& occluders, Vec3 a,
+                     Vec3 b, long* n_rays);
 
 /// A planar quad shooter in a 2D frame of its plane: what exact visibility clips.
 struct ShooterPlane {
@@ -126,6 +130,12 @@ struct BlockedView {
     std::vector<int> occluders;          // then: the occluders that meet p's pyramid
     bool trivial() const { return !behind_all && !horizon_cuts && shadows.empty() && !use_rays; }
 };
+/// The context's candidates that meet the pyramid from p to a planar shooter (the convex hull
+/// of p and the shooter's outline), increasing: the only polygons that can block a segment
+/// from p to a point of the shooter. The octree finds them when the candidates are many.
+std::vector<int> occluders_toward(const OcclusionContext& context, const ShooterPlane& plane,
+                                  Vec3 p);
+
 /// The view from point p (normal n_p). `context` may be null (horizon only). When p lies on a
 /// planar receiver, `receiver_plane` (may be null) gives its plane: the horizon is then the
 /// same line for every point of the receiver, to the last bit.
