@@ -11,6 +11,7 @@
 
 #include "examples/common/cli.h"
 #include "examples/common/scene_cli.h"
+#include "radiosity/output_file.h"
 
 namespace mbr {
 namespace {
@@ -31,6 +32,7 @@ int run(Args& args) {
     const bool per_shot = args.flag("--per-shot");
     const bool csv = args.flag("--csv");
     const std::string out = args.text("-o", "");
+    if (!out.empty()) check_output_path(out);  // refuse an unwritable path before solving
     SceneRun run =
         read_scene_run(args, std::string(MBR_SOURCE_DIR) + "/examples/scenes/cornell_box.scene");
     args.finish();
@@ -43,7 +45,12 @@ int run(Args& args) {
     } else {
         print_summary(std::cout, run, solution.stats);
     }
-    (void)out;
+    if (!out.empty()) {
+        const double seconds = write_render(run, solution, out);
+        // The CSV stays one table; the note goes to stderr then.
+        (csv ? std::cerr : std::cout) << "wrote " << out << " (rendered in " << cell(seconds, 2)
+                                      << " s)\n";
+    }
     return 0;
 }
 

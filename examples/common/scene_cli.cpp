@@ -12,6 +12,8 @@
 
 #include "math/check.h"
 #include "math/parallel.h"
+#include "radiosity/image.h"
+#include "radiosity/output_file.h"
 #include "radiosity/scene_io.h"
 #include "radiosity/scene_octree.h"
 
@@ -43,8 +45,19 @@ const char* solver_options_usage =
     "  --threads n               OpenMP threads, 1..256 (default: all cores)\n"
     "  --quiet                   no progress bar\n";
 
-SceneRun read_scene_run(Args& args, const std::string& default_scene) {
-    SceneRun run;
+namespace {
+
+/// The solver options of the command line, read before the scene is known.
+struct SolverArgs {
+    int order = -1, min_depth = -1, max_depth = -1, shots = -1, rays = -1;
+    double convergence = -1, tolerance = -1;
+    std::string shadows, unify, ambient, hidden;
+    // Which options the command line gave: only those override the scene's `set` lines.
+    bool has_min_depth = false, has_max_depth = false, has_tolerance = false,
+         has_shadows = false, has_unify = false, has_ambient = false, has_hidden = false;
+};
+
+SolverArgs read_solver_args(Args& args, SceneRun& run) {
     auto in_range = [](const std::string& name, double v, double lo, double hi,
                        bool open_lo = false, bool open_hi = false) {
         const bool ok = (open_lo ? v > lo : v >= lo) && (open_hi ? v < hi : v <= hi);
@@ -55,71 +68,105 @@ SceneRun read_scene_run(Args& args, const std::string& default_scene) {
             throw UsageError(os.str());
         }
     };
-    // Read every option first: the scene path is what is left.
-    const int order = args.integer("--order", -1);
-    const int min_depth = args.integer("--min-depth", -1);
-    const int max_depth = args.integer("--max-depth", -1);
-    const int shots = args.integer("--shots", -1);
-    const double convergence = args.number("--convergence", -1);
-    const double tolerance = args.number("--tolerance", -1);
-    const std::string shadows = args.text("--shadows", "exact");
-    const int rays = args.integer("--rays", -1);
-    const std::string unify = args.text("--unify", "projection");
-    const std::string ambient = args.text("--ambient", "on");
-    const std::string hidden = args.text("--hidden", "on");
+    SolverArgs a;
+    a.order = args.integer("--order", -1);
+    a.min_depth = args.integer("--min-depth", -1);
+    a.max_depth = args.integer("--max-depth", -1);
+    a.shots = args.integer("--shots", -1);
+    a.convergence = args.number("--convergence", -1);
+    a.tolerance = args.number("--tolerance", -1);
+    a.shadows = args.text("--shadows", "exact");
+    a.rays = args.integer("--rays", -1);
+    a.unify = args.text("--unify", "projection");
+    a.ambient = args.text("--ambient", "on");
+    a.hidden = args.text("--hidden", "on");
     run.threads = args.integer("--threads", 0);
     run.quiet = args.flag("--quiet");
+    a.has_min_depth = args.has("--min-depth");
+    a.has_max_depth = args.has("--max-depth");
+    a.has_tolerance = args.has("--tolerance");
+    a.has_shadows = args.has("--shadows");
+    a.has_unify = args.has("--unify");
+    a.has_ambient = args.has("--ambient");
+    a.has_hidden = args.has("--hidden");
+
+    if (args.has("--order")) in_range("--order", a.order, 2, 8);
+    if (a.has_min_depth) in_range("--min-depth", a.min_depth, 0, 12);
+    if (a.has_max_depth) in_range("--max-depth", a.max_depth, 0, 12);
+    if (args.has("--shots")) in_range("--shots", a.shots, 0, 1e7);
+    if (args.has("--convergence")) in_range("--convergence", a.convergence, 0, 1, false, true);
+    if (a.has_tolerance) in_range("--tolerance", a.tolerance, 0, 1, true, true);
+    if (args.has("--rays")) in_range("--rays", a.rays, 1, 4096);
+    if (args.has("--threads")) in_range("--threads", run.threads, 1, 256);
+    if (a.shadows != "exact" && a.shadows != "paper" && a.shadows != "none")
+        throw UsageError("--shadows must be exact, paper or none");
+    if (a.unify != "projection" && a.unify != "paper")
+        throw UsageError("--unify must be projection or paper");
+    for (const auto& [name, value] :
+         {std::pair{"--ambient", a.ambient}, std::pair{"--hidden", a.hidden}})
+        if (value != "on" && value != "off")
+            throw UsageError(std::string(name) + " must be on or off");
+    return a;
+}
+
+/// The scene's settings, then the command line over them; threads; the octree.
+void finish_scene_run(const SolverArgs& a, SceneRun& run) {
+    SolverOptions& o = run.options;
+    o = solver_options(run.scene.settings);
+    if (a.order > 0) o.receiver.m = a.order;
+    if (a.min_depth >= 0) o.receiver.min_depth = a.min_depth;
+    if (a.max_depth >= 0) o.receiver.max_depth = a.max_depth;
+    if (o.receiver.min_depth > o.receiver.max_depth) {
+        if (a.has_min_depth && a.has_max_depth)
+            throw UsageError("--min-depth must not exceed --max-depth");
+        // One bound given on the command line moves the other along.
+        if (a.has_max_depth)
+            o.receiver.min_depth = o.receiver.max_depth;
+        else
+            o.receiver.max_depth = o.receiver.min_depth;
+    }
+    if (a.shots >= 0) o.max_shots = a.shots;
+    if (a.convergence >= 0) o.convergence = a.convergence;
+    if (a.has_tolerance) o.tolerance = a.tolerance;
+    if (a.has_shadows)
+        o.receiver.shadows.method = a.shadows == "exact"   ? ShadowMethod::Exact
+                                    : a.shadows == "paper" ? ShadowMethod::Fractions
+                                                           : ShadowMethod::None;
+    if (a.rays > 0) o.receiver.shadows.rays_per_patch = a.rays;
+    if (a.has_ambient) o.ambient = a.ambient == "on";
+    if (a.has_unify) o.receiver.unify_by_projection = a.unify == "projection";
+    if (a.has_hidden) o.hidden_regions = a.hidden == "on";
+#ifdef _OPENMP
+    if (run.threads > 0) omp_set_num_threads(run.threads);
+#endif
+    run.octree = std::make_unique<Octree>(build_octree(run.scene));
+}
+
+}  // namespace
+
+SceneRun read_scene_run(Args& args, const std::string& default_scene) {
+    SceneRun run;
+    // Read every option first: the scene path is what is left.
+    const SolverArgs a = read_solver_args(args, run);
     const std::vector<std::string> pos = args.positional();
     if (pos.size() > 1)
         throw UsageError("one scene file, please (got " + std::to_string(pos.size()) + ")");
     if (pos.empty() && default_scene.empty()) throw UsageError("a scene file is required");
     run.path = pos.empty() ? default_scene : pos[0];
-
-    if (args.has("--order")) in_range("--order", order, 2, 8);
-    if (args.has("--min-depth")) in_range("--min-depth", min_depth, 0, 12);
-    if (args.has("--max-depth")) in_range("--max-depth", max_depth, 0, 12);
-    if (args.has("--shots")) in_range("--shots", shots, 0, 1e7);
-    if (args.has("--convergence")) in_range("--convergence", convergence, 0, 1, false, true);
-    if (args.has("--tolerance")) in_range("--tolerance", tolerance, 0, 1, true, true);
-    if (args.has("--rays")) in_range("--rays", rays, 1, 4096);
-    if (args.has("--threads")) in_range("--threads", run.threads, 1, 256);
-    if (shadows != "exact" && shadows != "paper" && shadows != "none")
-        throw UsageError("--shadows must be exact, paper or none");
-    if (unify != "projection" && unify != "paper") throw UsageError("--unify must be projection or paper");
-    for (const auto& [name, value] : {std::pair{"--ambient", ambient}, std::pair{"--hidden", hidden}})
-        if (value != "on" && value != "off") throw UsageError(std::string(name) + " must be on or off");
-
     const bool obj = run.path.size() > 4 && run.path.compare(run.path.size() - 4, 4, ".obj") == 0;
     run.scene = obj ? load_obj(run.path) : load_scene(run.path);
-    SolverOptions& o = run.options;
-    o = solver_options(run.scene.settings);
-    if (order > 0) o.receiver.m = order;
-    if (min_depth >= 0) o.receiver.min_depth = min_depth;
-    if (max_depth >= 0) o.receiver.max_depth = max_depth;
-    if (o.receiver.min_depth > o.receiver.max_depth) {
-        if (args.has("--min-depth") && args.has("--max-depth"))
-            throw UsageError("--min-depth must not exceed --max-depth");
-        // One bound given on the command line moves the other along.
-        if (args.has("--max-depth"))
-            o.receiver.min_depth = o.receiver.max_depth;
-        else
-            o.receiver.max_depth = o.receiver.min_depth;
-    }
-    if (shots >= 0) o.max_shots = shots;
-    if (convergence >= 0) o.convergence = convergence;
-    if (args.has("--tolerance")) o.tolerance = tolerance;
-    if (args.has("--shadows"))
-        o.receiver.shadows.method = shadows == "exact"   ? ShadowMethod::Exact
-                                    : shadows == "paper" ? ShadowMethod::Fractions
-                                                         : ShadowMethod::None;
-    if (rays > 0) o.receiver.shadows.rays_per_patch = rays;
-    if (args.has("--ambient")) o.ambient = ambient == "on";
-    if (args.has("--unify")) o.receiver.unify_by_projection = unify == "projection";
-    if (args.has("--hidden")) o.hidden_regions = hidden == "on";
-#ifdef _OPENMP
-    if (run.threads > 0) omp_set_num_threads(run.threads);
-#endif
-    run.octree = std::make_unique<Octree>(build_octree(run.scene));
+    finish_scene_run(a, run);
+    return run;
+}
+
+SceneRun read_scene_run(Args& args, Scene scene, const std::string& name) {
+    SceneRun run;
+    const SolverArgs a = read_solver_args(args, run);
+    const std::vector<std::string> pos = args.positional();
+    if (!pos.empty()) throw UsageError("unexpected argument '" + pos[0] + "'");
+    run.path = name;
+    run.scene = std::move(scene);
+    finish_scene_run(a, run);
     return run;
 }
 
@@ -203,6 +250,16 @@ void print_summary(std::ostream& os, const SceneRun& run, const SolveStats& st) 
        << cell(double(st.peak_memory_bytes) / (1024.0 * 1024.0), 1) << " MiB, coefficients "
        << st.coefficients << " per channel\n"
        << "kernel evaluations " << st.kernel_evals << ", shadow rays " << st.rays << "\n";
+}
+
+double write_render(const SceneRun& run, const Solution& solution, const std::string& path,
+                    const RenderOptions& options) {
+    if (!run.scene.has_camera)
+        throw InputError(run.path, 0, "the scene has no camera statement: nothing to render from");
+    const double start = now_seconds();
+    const Image radiance = render_radiance(run.scene, *run.octree, solution.radiosity, options);
+    write_files({{path, encode_png(tone_map(radiance, options.exposure))}});
+    return now_seconds() - start;
 }
 
 }  // namespace mbr

@@ -10,6 +10,7 @@
 
 #include "examples/common/cli.h"
 #include "octree/octree.h"
+#include "radiosity/render.h"
 #include "radiosity/scene.h"
 #include "radiosity/solver.h"
 
@@ -33,6 +34,10 @@ struct SceneRun {
 /// positional argument, or `default_scene` when empty and none is given), loads the scene and
 /// builds its octree. Call it after reading the program's own options.
 SceneRun read_scene_run(Args& args, const std::string& default_scene);
+/// The same for a scene made by the program: the options of solver_options_usage without SCENE
+/// (a positional argument is refused), applied over the scene's settings; `name` stands for the
+/// path in summaries.
+SceneRun read_scene_run(Args& args, Scene scene, const std::string& name);
 
 /// Solves, with a progress bar on stderr when it is a terminal and `progress` is set.
 Solution solve_scene(SceneRun& run, bool progress);
@@ -43,5 +48,11 @@ void print_shots(std::ostream& os, const Scene& scene, const SolveStats& stats);
 void print_summary(std::ostream& os, const SceneRun& run, const SolveStats& stats);
 /// shots, unshot_percent, seconds, peak_mib, coefficients.
 std::vector<std::string> summary_cells(const SolveStats& stats);
+
+/// Renders the solution with the scene's camera (radiance B / pi, sRGB tone mapping with
+/// options.exposure) and writes it as a PNG to `path` (all or nothing, radiosity/output_file.h).
+/// InputError when the scene has no camera. Returns the render's seconds.
+double write_render(const SceneRun& run, const Solution& solution, const std::string& path,
+                    const RenderOptions& options = {});
 
 }  // namespace mbr

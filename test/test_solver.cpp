@@ -1,0 +1,441 @@
+// test/test_solver.cpp - the progressive loop over whole scenes (paper section 4;
+// radiosity/solver.h) and its solution files (docs/solution-format.md).
+//
+// Independent references: the power balance of a closed box (everything a shooter sends arrives
+// on some face), the single transfer of radiosity/receiver.h run by hand with the options the
+// loop gives it, and the analytic point-to-polygon form factor for a first bounce. The scenes
+// are small and the depths low, so that every test runs in about a second.
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "math/check.h"
+#include "radiosity/hidden.h"
+#include "radiosity/kernel.h"
+#include "radiosity/receiver.h"
+#include "radiosity/scene_io.h"
+#include "radiosity/scene_octree.h"
+#include "radiosity/shadow.h"
+#include "radiosity/solver.h"
+#include "test/report.h"
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+using namespace mbr;
+
+namespace {
+
+Scene scene_from(const std::string& text, const std::string& name = "test.scene") {
+    std::istringstream in(text);
+    return parse_scene(in, name);
+}
+
+/// A closed unit cube of inward faces, reflectance 0.5, only the top face (cube.ymax) emitting.
+Scene top_light_cube() {
+    Scene scene = scene_from(
+        "material white reflectance 0.5 0.5 0.5\n"
+        "material glow  reflectance 0.5 0.5 0.5 emission 1 1 1\n"
+        "box cube white  0 0 0  1 1 1  inward\n");
+    scene.surfaces[scene.find_surface("cube.ymax")].material = scene.find_material("glow");
+    return scene;
+}
+
+/// A floor and a wall lit by a square light with a small box between them (floating, or with
+/// `block_bottom` = 0 resting on the floor): an umbra, penumbrae, receivers that run in
+/// parallel within each shot.
+Scene shadowed_floor(double block_bottom = 0.3) {
+    return scene_from(
+        "material grey  reflectance 0.6 0.5 0.4\n"
+        "material light reflectance 0.3 0.3 0.3 emission 5 5 5\n"
+        "rectangle floor grey   0 0 0   0 0 2   2 0 0\n"
+        "rectangle wall  grey   0 0 2   0 1.5 0   2 0 0\n"
+        "rectangle light light  0.7 1.4 0.7   0.6 0 0   0 0 0.6\n"
+        "box block grey  0.8 " +
+        std::to_string(block_bottom) + " 0.8  1.2 " + std::to_string(block_bottom + 0.3) +
+        " 1.2\n");
+}
+
+/// The options the scene programs solve with (examples/common/scene_cli.cpp): the scene's
+/// settings and exact shadows (solver_options() itself keeps the paper's fractions).
+SolverOptions program_options(const Scene& scene, int max_shots) {
+    SolverOptions o = solver_options(scene.settings);
+    o.receiver.shadows.method = ShadowMethod::Exact;
+    o.max_shots = max_shots;
+    o.convergence = 0;
+    return o;
+}
+
+/// Fast options for the tests: shallow trees and a coarse accuracy.
+SolverOptions quick_options(const Scene& scene, int max_shots) {
+    SolverOptions o = program_options(scene, max_shots);
+    o.receiver.min_depth = 1;
+    o.receiver.max_depth = 3;
+    o.tolerance = 1e-2;
+    o.max_shots = max_shots;
+    o.convergence = 0;
+    return o;
+}
+
+bool same_fields(const SplineField& a, const SplineField& b) {
+    if (a.order() != b.order() || a.level() != b.level()) return false;
+    for (int c = 0; c < 3; ++c)
+        if (a.channel(c).a != b.channel(c).a) return false;
+    return true;
+}
+
+std::string saved(const Scene& scene, const Solution& solution) {
+    std::ostringstream os;
+    save_solution(os, scene, solution);
+    return os.str();
+}
+
+/// The message of the InputError that loading `text` throws (empty when it loads).
+std::string load_error(const std::string& text, const Scene& scene, int* line = nullptr) {
+    std::istringstream in(text);
+    try {
+        load_solution(in, "x.solution", scene);
+    } catch (const InputError& e) {
+        if (line) *line = e.line();
+        return e.what();
+    }
+    return "";
+}
+
+}  // namespace
+
+TEST_CASE("solver: emitted power is absorbed or still unshot after every shot", "[solver]") {
+    const Scene scene = top_light_cube();
+    const Octree octree = build_octree(scene);
+    ProgressiveSolver solver(scene, octree, quick_options(scene, 12));
+    const double emitted = solver.solution().stats.emitted_power;
+    REQUIRE(emitted == Approx(3.0));  // one unit face, E = 1 in three channels
+    double absorbed = 0;
+    while (!solver.done()) {
+        const ShotStats shot = solver.shoot();
+        CAPTURE(shot.shot, shot.shooter);
+        // The loop's own bookkeeping: the shooter's unshot power leaves, the receivers'
+        // reflected power joins. Exact but for rounding (the power weights integrate the splines
+        // exactly on planar faces).
+        CHECK(shot.unshot_after ==
+              Approx(shot.unshot_before - shot.shooter_power + shot.reflected).epsilon(1e-10));
+        // A closed box: all the shooter sends arrives on the five other faces (their form
+        // factors sum to one), up to the transfers' accuracy. Their absolute tolerance is 1e-2
+        // of the radiosity scale, which weak late shots feel most: measured, the incident power
+        // is within 0.8 % of the shot power per shot and the running total below within 0.25 %.
+        // 2 % and 1 % leave room for that and are far below a face lost (a fifth of the power).
+        CHECK(shot.incident == Approx(shot.shooter_power).epsilon(2e-2));
+        CHECK(shot.reflected == Approx(0.5 * shot.incident).epsilon(1e-12));  // rho = 0.5
+        absorbed += shot.incident - shot.reflected;
+        // Emitted = absorbed so far + unshot, to the accuracy of the incident power (above).
+        CHECK(absorbed + shot.unshot_after == Approx(emitted).epsilon(1e-2));
+        test::report() << "shot " << shot.shot << ": incident/shot power "
+                       << shot.incident / shot.shooter_power << ", (absorbed + unshot)/emitted "
+                       << (absorbed + shot.unshot_after) / emitted << "\n";
+    }
+    CHECK(solver.solution().stats.shots == 12);
+}
+
+namespace {
+
+/// The lowest value of any channel of B on an (n+1) x (n+1) grid that includes the edges and
+/// corners of [0,1]^2 (NaN when some value is not finite).
+double lowest_value(const SplineField& B, int n) {
+    double lowest = 1e300;
+    for (int a = 0; a <= n; ++a)
+        for (int b = 0; b <= n; ++b) {
+            const Rgb v = B.evaluate(double(a) / n, double(b) / n);
+            for (int c = 0; c < 3; ++c) {
+                if (!std::isfinite(v[c])) return std::nan("");
+                lowest = std::min(lowest, v[c]);
+            }
+        }
+    for (int c = 0; c < 3; ++c)
+        for (double a : B.channel(c).a)
+            if (!std::isfinite(a)) return std::nan("");
+    return lowest;
+}
+
+/// Every surface's lowest value after six shots with the programs' options (depths 1..6,
+/// tolerance 1e-3, exact shadows).
+std::vector<double> lowest_values(const Scene& scene) {
+    const Octree octree = build_octree(scene);
+    const Solution solution = solve(scene, octree, program_options(scene, 6));
+    REQUIRE(solution.stats.shots == 6);
+    std::vector<double> lowest;
+    for (size_t i = 0; i < scene.surfaces.size(); ++i) {
+        lowest.push_back(lowest_value(solution.radiosity[i], 64));
+        test::report() << scene.surfaces[i].name << ": lowest B " << lowest.back() << "\n";
+    }
+    return lowest;
+}
+
+}  // namespace
+
+TEST_CASE("solver: radiosity is never negative or NaN", "[solver]") {
+    // A floating block casts an umbra (where the light's increment is exactly zero) ringed by
+    // penumbrae on the floor, and a lit wall meets the floor. At max_depth 3 this umbra rings
+    // below zero (-0.009 against a largest 0.14, measured): the splines cannot follow the
+    // penumbra at that resolution; at the default depths they do.
+    const Scene scene = shadowed_floor(0.3);
+    const std::vector<double> lowest = lowest_values(scene);
+    for (size_t i = 0; i < scene.surfaces.size(); ++i) {
+        CAPTURE(scene.surfaces[i].name);
+        CHECK(lowest[i] >= 0);  // false for NaN too
+    }
+}
+
+// Known defect, kept visible: [!shouldfail] passes while the check fails; when the solver is
+// fixed, this test fails and the tag must go. A block resting on the floor hides a square of it;
+// the hidden region's samples take the nearest visible values (radiosity/hidden.h), which are
+// nearly zero in the block's contact shadow, and the floor's spline dips to -0.0044 there
+// (against a largest 0.16, measured on this 65 x 65 grid). The points are hidden (nobody sees
+// them), but the field's power integral includes them. (The Cornell box also dips below zero
+// at visible points, e.g. at the short block's footprint corner and the room's corners.)
+TEST_CASE("solver: radiosity is never negative under a block resting on the floor",
+          "[solver][!shouldfail]") {
+    const Scene scene = shadowed_floor(0.0);
+    const std::vector<double> lowest = lowest_values(scene);
+    for (size_t i = 0; i < scene.surfaces.size(); ++i) {
+        CAPTURE(scene.surfaces[i].name);
+        CHECK(lowest[i] >= 0);
+    }
+}
+
+TEST_CASE("solver: one bounce between two surfaces is the single transfer", "[solver]") {
+    const Scene scene = scene_from(
+        "material light reflectance 0 0 0 emission 2 3 4\n"
+        "material grey  reflectance 0.7 0.5 0.3\n"
+        "rectangle light light  0 0 1   0 1 0   1 0 0\n"    // facing down
+        "rectangle floor grey   0 0 0   1 0 0   0 1 0\n");  // facing up, a unit apart
+    const Octree octree = build_octree(scene);
+    SolverOptions o = quick_options(scene, 1);
+    o.receiver.max_depth = 4;
+    ProgressiveSolver solver(scene, octree, o);
+    const ShotStats shot = solver.shoot();
+    REQUIRE(shot.shooter == 0);
+    REQUIRE(shot.receivers == 1);
+
+    // The transfer by hand, with the options ProgressiveSolver::shoot gives it: absolute
+    // tolerances from the scene's radiosity scale, the shooter coarsened to shooter_level (an
+    // emitter's constant field is level 0, so the coarsening changes nothing here).
+    ReceiverOptions ro = o.receiver;
+    ro.absolute_tolerance = o.tolerance * solver.radiosity_scale();
+    ro.quadrature.abs_tolerance = o.quadrature_share * ro.absolute_tolerance;
+    const SplineField E = project_emission(scene.materials[0].emission, ro.m, o.emission_level);
+    const int coarsen = std::max(ro.shooter_coarsening, E.level() - o.shooter_level);
+    const Shooter shooter = make_shooter(scene.surfaces[0].surface, E, coarsen);
+    const Texture& rho = scene.materials[1].reflectance;
+    const HiddenMask hidden = find_hidden(scene.surfaces[1].surface, 1, octree, o.hidden);
+    const ReceiverSurface receiver{&scene.surfaces[1].surface,
+                                   [&rho](double s, double t) { return rho.value(s, t); },
+                                   hidden.any() ? &hidden : nullptr};
+    const OcclusionContext occlusion = make_occlusion_context(octree, scene.surfaces[0].surface, 0,
+                                                              scene.surfaces[1].surface, 1, 1);
+    const SplineField dB = transfer(shooter, receiver, ro, nullptr, nullptr, &occlusion);
+
+    // The floor started dark: its radiosity and its unshot field are that increment, coefficient
+    // for coefficient (the same computation; the sum 0 + dB is exact).
+    CHECK(same_fields(solver.solution().radiosity[1], dB));
+    CHECK(same_fields(solver.solution().unshot[1], dB));
+    // The light keeps its emission and has nothing left to shoot.
+    CHECK(solver.solution().radiosity[0].evaluate(0.3, 0.6).g == Approx(3.0));
+    CHECK(solver.unshot_power(0) == 0);
+
+    // Both against the analytic answer dB = rho E F(x -> light): the transfers' absolute
+    // tolerance is 1e-2 of the radiosity scale (E over the total area: 1.5 in green); 2 % of the
+    // value (about 0.2 here) is an order above the measured error and far below any mistake in
+    // the options (a wrong rho or E changes it by 30 % or more).
+    const Surface& L = scene.surfaces[0].surface;
+    const std::vector<Vec3> light = {L.point(0, 0), L.point(1, 0), L.point(1, 1), L.point(0, 1)};
+    const Surface& floor = scene.surfaces[1].surface;
+    double worst = 0;
+    for (double s : {0.05, 0.3, 0.5, 0.8, 0.95})
+        for (double t : {0.05, 0.4, 0.5, 0.9}) {
+            const double F =
+                point_polygon_form_factor(floor.point(s, t), floor.normal(s, t), light);
+            const Rgb got = dB.evaluate(s, t);
+            const Rgb exact = {0.7 * 2 * F, 0.5 * 3 * F, 0.3 * 4 * F};
+            for (int c = 0; c < 3; ++c) {
+                CAPTURE(s, t, c, got[c], exact[c]);
+                CHECK(got[c] == Approx(exact[c]).epsilon(2e-2));
+                worst = std::max(worst, std::abs(got[c] - exact[c]) / exact[c]);
+            }
+        }
+    test::report() << "one bounce: worst relative error against the form factor " << worst << "\n";
+}
+
+#ifdef _OPENMP
+TEST_CASE("solver: results do not depend on the thread count", "[solver]") {
+    const Scene scene = shadowed_floor();
+    const Octree octree = build_octree(scene);
+    const SolverOptions o = quick_options(scene, 2);
+    const int before = omp_get_max_threads();
+    omp_set_num_threads(1);
+    const Solution one = solve(scene, octree, o);
+    omp_set_num_threads(2);
+    const Solution two = solve(scene, octree, o);
+    omp_set_num_threads(before);
+    REQUIRE(one.stats.shots == 2);
+    // The saved files hold every coefficient with 17 digits, the leaves and the names: equal
+    // text means equal solutions, bit for bit.
+    CHECK(saved(scene, one) == saved(scene, two));
+    for (size_t i = 0; i < scene.surfaces.size(); ++i) {
+        CAPTURE(scene.surfaces[i].name);
+        CHECK(same_fields(one.radiosity[i], two.radiosity[i]));
+    }
+    CHECK(one.stats.kernel_evals == two.stats.kernel_evals);
+    CHECK(one.stats.rays == two.stats.rays);
+}
+#endif
+
+TEST_CASE("solver: a saved solution loads back identical", "[solver]") {
+    const Scene scene = top_light_cube();
+    const Octree octree = build_octree(scene);
+    const Solution solution = solve(scene, octree, quick_options(scene, 3));
+    const std::string text = saved(scene, solution);
+    std::istringstream in(text);
+    const Solution loaded = load_solution(in, "x.solution", scene);
+    REQUIRE(loaded.radiosity.size() == scene.surfaces.size());
+    for (size_t i = 0; i < scene.surfaces.size(); ++i) {
+        CAPTURE(scene.surfaces[i].name);
+        CHECK(same_fields(loaded.radiosity[i], solution.radiosity[i]));
+        CHECK(same_fields(loaded.unshot[i], solution.unshot[i]));
+        REQUIRE(loaded.leaves[i].size() == solution.leaves[i].size());
+        for (size_t k = 0; k < loaded.leaves[i].size(); ++k)
+            CHECK(loaded.leaves[i][k] == solution.leaves[i][k]);
+    }
+    // And saves again to the same text.
+    CHECK(saved(scene, loaded) == text);
+}
+
+TEST_CASE("solver: damaged, truncated and foreign solution files are refused", "[solver]") {
+    const Scene scene = top_light_cube();
+    const Octree octree = build_octree(scene);
+    const Solution solution = solve(scene, octree, quick_options(scene, 2));
+    const std::string text = saved(scene, solution);
+    REQUIRE(load_error(text, scene).empty());
+
+    SECTION("truncated at a line end: the message says so") {
+        // Cut after each of a spread of lines (never after the last one, "end").
+        std::vector<size_t> line_ends;
+        for (size_t p = text.find('\n'); p + 1 < text.size(); p = text.find('\n', p + 1))
+            line_ends.push_back(p + 1);
+        REQUIRE(line_ends.size() > 10);
+        for (size_t k = 0; k < line_ends.size(); k += line_ends.size() / 10) {
+            CAPTURE(k);
+            const std::string message = load_error(text.substr(0, line_ends[k]), scene);
+            CHECK(message.find("x.solution:") == 0);
+            CHECK(message.find("ends early") != std::string::npos);
+            CHECK(message.find("truncated") != std::string::npos);
+        }
+    }
+    SECTION("truncated anywhere: refused") {
+        for (size_t cut = 0; cut + 2 < text.size(); cut += text.size() / 37 + 1) {
+            CAPTURE(cut);
+            CHECK(!load_error(text.substr(0, cut), scene).empty());
+        }
+    }
+    SECTION("a damaged number: refused with its line") {
+        // The first coefficient line of the first surface's radiosity: line 6 (after the
+        // header, fingerprint, sizes, surface and field lines).
+        std::istringstream lines(text);
+        std::vector<std::string> all;
+        for (std::string line; std::getline(lines, line);) all.push_back(line);
+        REQUIRE(all[4].rfind("radiosity level", 0) == 0);
+        std::string& numbers = all[5];
+        const size_t space = numbers.find(' ');
+        REQUIRE(space != std::string::npos);
+        for (const std::string bad : {"1.2.3", "nan", "inf", "1e999", "seven"}) {
+            CAPTURE(bad);
+            std::string damaged;
+            for (size_t i = 0; i < all.size(); ++i)
+                damaged += (i == 5 ? bad + numbers.substr(space) : all[i]) + "\n";
+            int line = 0;
+            const std::string message = load_error(damaged, scene, &line);
+            CHECK(line == 6);
+            CHECK(message.find("x.solution:6: expected a finite number, found '" + bad + "'") == 0);
+        }
+        // A number missing from the line.
+        std::string short_line;
+        for (size_t i = 0; i < all.size(); ++i)
+            short_line += (i == 5 ? numbers.substr(space + 1) : all[i]) + "\n";
+        CHECK(load_error(short_line, scene).find("x.solution:6: expected ") == 0);
+    }
+    SECTION("another scene's solution: refused, naming the fingerprints") {
+        Scene other = top_light_cube();
+        other.surfaces[0].name = "ground";  // the same geometry under another name
+        const std::string message = load_error(text, other);
+        CHECK(message.find("x.solution:2: the solution was made for another scene") == 0);
+        Scene paler = top_light_cube();  // a reflectance changed in the third decimal
+        paler.materials[0].reflectance = Texture::constant({0.5, 0.5, 0.501});
+        CHECK(load_error(text, paler).find("made for another scene") != std::string::npos);
+        CHECK(load_error(text, shadowed_floor()).find("made for another scene") !=
+              std::string::npos);
+    }
+    SECTION("another version: refused") {
+        std::string v2 = text;
+        v2.replace(0, v2.find('\n'), "mbr-solution 2");
+        CHECK(load_error(v2, scene).find("x.solution:1: solution format version 2 is not "
+                                         "supported") == 0);
+        CHECK(load_error("P6\n", scene).find("not an mbr solution file") != std::string::npos);
+    }
+}
+
+TEST_CASE("solver: a surface solved at depth 8 shoots", "[solver]") {
+    // A small floor under a small light, the receivers' trees forced to depth 8 everywhere;
+    // then the floor, holding a level-8 field, shoots to a panel above the light's plane (which
+    // the light cannot reach, so that only the floor receives in the first shot). The floor's
+    // field is coarsened to shooter_level before it shoots (the default, 3) or shoots whole (8).
+    const Scene scene = scene_from(
+        "material light reflectance 0 0 0 emission 4 4 4\n"
+        "material grey  reflectance 0.5 0.5 0.5\n"
+        "rectangle light light  0 0.5 0   0.25 0 0   0 0 0.25\n"      // facing down
+        "rectangle floor grey   0 0 0   0 0 0.25   0.25 0 0\n"        // facing up, under it
+        "rectangle panel grey   0.35 0.6 0   0.3 0 0   0 0 0.25\n");  // facing down, aside
+    const Octree octree = build_octree(scene);
+    for (int shooter_level : {3, 8}) {
+        CAPTURE(shooter_level);
+        SolverOptions o = quick_options(scene, 2);
+        o.receiver.m = 2;  // four samples per leaf: 2^16 leaves stay affordable
+        o.receiver.min_depth = 8;
+        o.receiver.max_depth = 8;
+        // Without this a receiver whose root was never sampled (min = max leaves the oracle
+        // nothing to decide) counts as weak and starts at the root (receiver.cpp).
+        o.receiver.weak_receiver = 0;
+        // Nothing stands between the floor and the panel: no visibility tests (faster).
+        o.receiver.shadows.method = ShadowMethod::None;
+        o.shooter_level = shooter_level;
+        ProgressiveSolver solver(scene, octree, o);
+        const ShotStats first = solver.shoot();
+        REQUIRE(first.shooter == 0);
+        REQUIRE(first.receivers == 1);
+        REQUIRE(solver.solution().radiosity[1].level() == 8);
+        const ShotStats shot = solver.shoot();
+        REQUIRE(shot.shooter == 1);  // the floor, the only surface with unshot power
+        CHECK(shot.receivers == 1);  // the panel (the light reflects nothing)
+        CHECK(shot.shooter_power > 0);
+        CHECK(solver.unshot_power(1) == 0);
+        const SplineField& panel = solver.solution().radiosity[2];
+        bool finite = true;
+        double lowest = 1e300, highest = 0;
+        for (int a = 0; a <= 16; ++a)
+            for (int b = 0; b <= 16; ++b) {
+                const double v = panel.evaluate(a / 16.0, b / 16.0).r;
+                finite = finite && std::isfinite(v);
+                lowest = std::min(lowest, v);
+                highest = std::max(highest, v);
+            }
+        CHECK(finite);
+        CHECK(lowest >= 0);
+        CHECK(highest > 0);
+        // Bookkeeping holds for the deep shooter too.
+        CHECK(shot.unshot_after ==
+              Approx(shot.unshot_before - shot.shooter_power + shot.reflected).epsilon(1e-10));
+        test::report() << "depth 8, shooter level " << shooter_level << ": shots took "
+                       << first.seconds << " and " << shot.seconds << " s\n";
+    }
+}
