@@ -216,9 +216,13 @@ int main(int argc, char** argv) {
             for (int i = 2; i < argc; ++i) sub.push_back(argv[i]);
             return run_main(static_cast<int>(sub.size()), sub.data(), c.usage, c.body);
         }
-    if (first.empty() || first == "--help" || first == "-h" || first == "help") {
-        (first.empty() ? std::cerr : std::cout) << main_usage;
-        return first.empty() ? 2 : 0;
+    if (first.empty()) {
+        std::cerr << "mbr: a command is required: render, probe, reference or tables (mbr --help)\n";
+        return 2;
+    }
+    if (first == "--help" || first == "-h" || first == "help") {
+        std::cout << main_usage;
+        return 0;
     }
     std::cerr << "mbr: unknown command '" << first << "' (mbr --help lists the commands)\n";
     return 2;

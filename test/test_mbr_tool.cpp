@@ -320,9 +320,6 @@ TEST_CASE("mbr_tool: bad arguments and bad input are status 2 with one stderr li
     }
 }
 
-// KNOWN FAILURE (reported to the lead, not fixed here): `mbr` without a command exits 2 as it
-// should, but prints the whole 11-line usage on stderr, where examples/mbr.cpp's header and
-// STYLE.md B7 promise one line, as for an unknown command.
 TEST_CASE("mbr_tool: no command is status 2 with one stderr line", "[mbr_tool]") {
     const ToolRun run = run_mbr({});
     CAPTURE(run);
