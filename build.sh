@@ -3,6 +3,7 @@
 #   ./build.sh main       install what is missing, build (Release, build/), run the main job
 #   ./build.sh test       install what is missing, build (build/), run every test through CTest
 #   ./build.sh sanitize   the same tests built with -DMBR_SANITIZE=ON in build-sanitize/
+#   ./build.sh gallery    build, then regenerate the README's pictures in docs/images/
 set -euo pipefail
 cd "$(dirname "$0")"
 
@@ -32,28 +33,37 @@ configure_and_build() {  # dir, extra cmake arguments...
 
 main_job() {
     mkdir -p out
-    echo "== Table 1: parallel squares, beside the paper =="
-    build/examples/table1_parallel_squares
+    echo "== The Cornell box: solved and rendered -> out/cornell_box.png =="
+    build/examples/mbr render examples/scenes/cornell_box.scene -o out/cornell_box.png
     echo
-    echo "== Table 1 again with the rhombus radius near the paper's (14 cells) =="
-    build/examples/table1_parallel_squares --rhombus-radius 14
-    echo
-    echo "== Table 2: perpendicular squares, beside the paper =="
-    build/examples/table2_perpendicular_squares
-    echo
-    echo "== Table 2 again with the rhombus radius near the paper's (14 cells) =="
-    build/examples/table2_perpendicular_squares --rhombus-radius 14
-    echo
-    echo "== Table 3: dual coefficients mu_{3;0,l} beside the paper =="
-    build/examples/table3_dual_coefficients
+    echo "== Tables 1, 2 and 3 computed now, beside the paper's values =="
+    build/examples/mbr tables
     echo
     echo "== Figure 1: DN_3 and DN_4 -> out/figure1_dual_basis.png =="
     build/examples/figure1_dual_basis -o out/figure1_dual_basis.png
-    if [ -x build/examples/figure7_error_images ]; then
-        echo
-        echo "== Figure 7: error images -> out/figure7a_parallel.png, out/figure7b_perpendicular.png =="
-        build/examples/figure7_error_images -o out
-    fi
+    echo
+    echo "== Figure 7: error images -> out/figure7a_parallel.png, out/figure7b_perpendicular.png =="
+    build/examples/figure7_error_images -o out
+}
+
+# The README's gallery, docs/images/: every picture the examples write, regenerated from scratch
+# (the room, solved with shadows to its shot limit, takes most of the time: minutes).
+gallery() {
+    local dir=docs/images tmp
+    mkdir -p "$dir"
+    tmp=$(mktemp -d)
+    trap 'rm -rf "$tmp"' RETURN
+    build/examples/mbr render examples/scenes/cornell_box.scene -o "$dir/cornell_box.png" --quiet
+    build/examples/mbr render examples/scenes/cornell_box.scene -o "$dir/cornell_box_quadtree.png" \
+        --quadtree --quiet
+    build/examples/figure1_dual_basis -o "$dir/figure1_dual_basis.png"
+    build/examples/figure7_error_images -o "$tmp"
+    cp "$tmp/figure7a_parallel.png" "$tmp/figure7b_perpendicular.png" "$dir/"
+    build/examples/figure8_coplanar_strips -o "$dir/figure8_coplanar_strips.png"
+    build/examples/shadow_transfer --config square --max-shadow-depth 6 -o "$tmp"
+    cp "$tmp"/*square*.png "$dir/"
+    build/examples/figure10_room -o "$dir/figure10_room.png"
+    ls -l "$dir"
 }
 
 case "${1:-}" in
@@ -67,13 +77,18 @@ case "${1:-}" in
         configure_and_build build
         (cd build && ctest --output-on-failure -j "$jobs")
         ;;
+    gallery)
+        install_missing
+        configure_and_build build
+        gallery
+        ;;
     sanitize)
         install_missing
         configure_and_build build-sanitize -DMBR_SANITIZE=ON
         (cd build-sanitize && ctest --output-on-failure -j "$jobs")
         ;;
     *)
-        echo "usage: ./build.sh main|test|sanitize" >&2
+        echo "usage: ./build.sh main|test|sanitize|gallery" >&2
         exit 2
         ;;
 esac
