@@ -13,7 +13,7 @@
 // the scene's camera (--spp samples per pixel, default 4).
 //
 // Default shots: the scene's `set max_shots` (60) as for every scene program, or --shots. The
-// first shots cost the most (the lamp's, with exact shadows over the whole room); the ambient
+// scene sets the paper's shadows (fractions (28)); every shot costs a few seconds, and the ambient
 // correction (on by default) stands in for what a shorter run leaves unshot.
 #include <algorithm>
 #include <cstdio>
