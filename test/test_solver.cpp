@@ -60,7 +60,7 @@ Scene shadowed_floor(double block_bottom = 0.3) {
 }
 
 /// The options the scene programs solve with (examples/common/scene_cli.cpp): the scene's
-/// settings and exact shadows (solver_options() itself keeps the paper's fractions).
+/// settings (exact shadows unless a scene sets others), made explicit here.
 SolverOptions program_options(const Scene& scene, int max_shots) {
     SolverOptions o = solver_options(scene.settings);
     o.receiver.shadows.method = ShadowMethod::Exact;
