@@ -61,8 +61,11 @@ double shadowed_form_factor(Vec3 p, Vec3 n_p, const std::vector<Vec3>& shooter,
     MBR_CHECK(shooter.size() >= 3 && occluder.size() >= 3);
     const double full = point_polygon_form_factor(p, n_p, shooter);
     // The shooter's plane, oriented so that p is in front.
+    // Newell's normal from vectors relative to the first vertex: over absolute positions its
+    // terms cancel down to the area and lose every digit for a tiny shooter far from the origin.
     Vec3 normal{};
-    for (size_t i = 0; i < shooter.size(); ++i) normal += cross(shooter[i], shooter[(i + 1) % shooter.size()]);
+    for (size_t i = 1; i + 1 < shooter.size(); ++i)
+        normal += cross(shooter[i] - shooter[0], shooter[i + 1] - shooter[0]);
     normal = normalize(normal);
     const double h_p = dot(normal, p - shooter[0]);
     if (h_p == 0) return full;

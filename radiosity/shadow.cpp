@@ -190,10 +190,12 @@ ShooterPlane make_shooter_plane(const Surface& quad) {
     const Vec3* c = quad.corners();
     ShooterPlane sp;
     sp.origin = 0.25 * (c[0] + c[1] + c[2] + c[3]);
-    // Newell's normal of the corners: the mean plane of a (slightly) non-planar quad.
-    Vec3 n{};
-    for (int i = 0; i < 4; ++i) n += cross(c[i], c[(i + 1) % 4]);
-    sp.normal = normalize(n);
+    // Newell's normal of the corners: the mean plane of a (slightly) non-planar quad. For four
+    // corners it is the cross product of the diagonals, which, unlike the sum of cross(c_i,
+    // c_{i+1}) over absolute positions (terms of order |c|^2 cancelling down to the area),
+    // keeps its digits for a quad far smaller than its distance from the origin (issue 11: a
+    // shooter of side 1e-8 at distance 1 got a normal off by radians).
+    sp.normal = normalize(cross(c[2] - c[0], c[3] - c[1]));
     sp.e1 = normalize(c[1] - c[0] - dot(c[1] - c[0], sp.normal) * sp.normal);
     sp.e2 = cross(sp.normal, sp.e1);
     for (int i = 0; i < 4; ++i) sp.corner[i] = sp.to_plane(c[i]);
@@ -214,9 +216,8 @@ ShooterPlane make_shooter_plane(const Surface& quad) {
 std::optional<Plane> surface_plane(const Surface& surface) {
     if (surface.kind() == Surface::Kind::PlanarQuad) {
         const Vec3* c = surface.corners();
-        Vec3 n{};
-        for (int i = 0; i < 4; ++i) n += cross(c[i], c[(i + 1) % 4]);
-        n = normalize(n);
+        // Newell's normal as the diagonals' cross product (see make_shooter_plane).
+        const Vec3 n = normalize(cross(c[2] - c[0], c[3] - c[1]));
         const Vec3 o = 0.25 * (c[0] + c[1] + c[2] + c[3]);
         // Only a quad planar to rounding: the scene format accepts corners 0.25 % off their
         // mean plane, whose tangent planes then differ from it.
