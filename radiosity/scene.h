@@ -61,6 +61,8 @@ struct SolverSettings {
                                            //   grid) or "paper" ((17) from selected fulcrums)
     bool ambient = true;                   // ambient correction of the unshot power at the end
     bool hidden = true;                    // hidden regions take their visible neighbours' values
+    int shooter_level = 5;                 // a shooter's unshot field coarsened to at most this
+                                           //   level (section 6's "lower resolution version")
 };
 
 /// A whole scene. Surface i's material is materials[surfaces[i].material].

@@ -1363,6 +1363,8 @@ private:
             if (value != "projection" && value != "paper")
                 line.fail("unify " + in_quotes(value) + " is neither 'projection' nor 'paper'");
             s.unify = value;
+        } else if (key == "shooter_level") {
+            s.shooter_level = integer(0, 12);
         } else if (key == "ambient" || key == "hidden") {
             if (value != "true" && value != "false")
                 line.fail(key + " " + in_quotes(value) + " is neither 'true' nor 'false'");
@@ -1371,7 +1373,8 @@ private:
             line.fail("unknown setting " + in_quotes(key) +
                       " (known: order, min_depth, max_depth, oracle_tolerance, truncation_eps, "
                       "rhombus_radius, extrapolation, shadow_rays, max_shots, convergence, "
-                      "self_transfer, tessellation, shadows, tolerance, unify, ambient, hidden)");
+                      "self_transfer, tessellation, shadows, tolerance, unify, ambient, hidden, "
+                      "shooter_level)");
         }
     }
 

@@ -118,6 +118,7 @@ SolverOptions solver_options(const SolverSettings& s) {
     o.tolerance = s.tolerance;
     o.ambient = s.ambient;
     o.hidden_regions = s.hidden;
+    o.shooter_level = s.shooter_level;
     return o;
 }
 
@@ -194,6 +195,7 @@ ProgressiveSolver::ProgressiveSolver(const Scene& scene, const Octree& octree,
     solution_.leaves.resize(n);
     split_cells_.resize(n);
     coupling_.resize(n);
+    shot_power_.assign(n, Rgb{});
     last_seconds_.assign(n, 0.0);
     weights_.resize(n);
     hidden_.resize(n);
@@ -366,7 +368,8 @@ ShotStats ProgressiveSolver::shoot() {
     // Superposition in receiver order: B_i += dB_i, B_unshot_i += dB_i; then B_unshot_h = 0.
     const Rgb shot_power = power(h, shooter.unshot);
     std::vector<Rgb>& row = coupling_[h];
-    row.assign(n, Rgb{});
+    if (row.empty()) row.assign(n, Rgb{});
+    shot_power_[h] += shot_power;
     for (int k = 0; k < n_rec; ++k) {
         const int i = receivers[k];
         Received& r = results[k];
@@ -378,7 +381,7 @@ ShotStats ProgressiveSolver::shoot() {
             if (rv[c] > 0) {
                 const double incident = reflected[c] / rv[c];
                 shot.incident += incident;
-                if (shot_power[c] > 0) row[i][c] = incident / shot_power[c];
+                row[i][c] += incident;
             }
         solution_.radiosity[i].add(r.field);
         solution_.unshot[i].add(r.field);
@@ -427,7 +430,12 @@ std::vector<Rgb> ProgressiveSolver::ambient_correction() const {
         total_area += area[i];
     }
     auto coupling = [&](int j, int i) -> Rgb {
-        if (!coupling_[j].empty()) return coupling_[j][i];
+        if (!coupling_[j].empty()) {
+            Rgb f;
+            for (int c = 0; c < 3; ++c)
+                f[c] = shot_power_[j][c] > 0 ? coupling_[j][i][c] / shot_power_[j][c] : 0.0;
+            return f;
+        }
         const double f = i == j ? 0.0 : area[i] / (total_area - area[j]);
         return {f, f, f};
     };

@@ -43,14 +43,16 @@ struct SolverOptions {
                                     //   face take the nearest visible point's value
                                     //   (radiosity/hidden.h)
     HiddenOptions hidden;           // how hidden points are found
-    int shooter_level = 3;          // a shooter's unshot field is coarsened to at most this
+    int shooter_level = 5;          // a shooter's unshot field is coarsened to at most this
                                     //   level (the paper's "lower resolution version", section
                                     //   6); the receiver options' shooter_coarsening levels at
-                                    //   least
+                                    //   least. DESIGN: 5, not 3: at level 3 the floor's shadows
+                                    //   are smeared and the dark front of the Cornell box's
+                                    //   short block converges 4.9 % low (docs/method.md)
     bool ambient = true;            // beyond the paper: at the end, the power still unshot is
                                     //   sent on through the measured coupling of the surfaces
-                                    //   (the fraction of each shooter's power each receiver got
-                                    //   in its last shot) and added as a constant radiosity per
+                                    //   (the fraction of each shooter's power each receiver got,
+                                    //   over all its shots) and added as a constant radiosity per
                                     //   surface (Cohen et al. 1988's ambient term, with measured
                                     //   instead of area-weighted coupling)
 };
@@ -124,9 +126,11 @@ private:
     DualTable dual_;
     Solution solution_;
     std::vector<std::vector<std::uint64_t>> split_cells_;  // per surface: cells split in some tree
-    /// coupling_[j][i]: the fraction of surface j's shot power (per channel) that reached
-    /// surface i in j's last shot (empty until j shoots).
+    /// coupling_[j][i]: the power (per channel) surface i received from all of j's shots, and
+    /// shot_power_[j] the power j shot in them: their ratio is the measured fraction of j's
+    /// power that reaches i (empty until j shoots).
     std::vector<std::vector<Rgb>> coupling_;
+    std::vector<Rgb> shot_power_;
     /// The ambient correction of SolverOptions::ambient, per surface: a constant radiosity.
     std::vector<Rgb> ambient_correction() const;
     double radiosity_scale_ = 0;

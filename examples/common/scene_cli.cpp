@@ -35,6 +35,8 @@ const char* solver_options_usage =
     "  --shadows M               exact (visibility inside (21), default), paper\n"
     "                            (fractions (28) and masking) or none (`set shadows`)\n"
     "  --rays R                  paper shadows: rays per shooter patch, 1..4096\n"
+    "  --shooter-level L         a shooter's unshot field is coarsened to at most level L,\n"
+    "                            0..12 (scene's `set shooter_level`, default 5)\n"
     "  --unify projection|paper  every finest coefficient projected on the fine grid\n"
     "                            (default), or the paper's (17) from selected fulcrums\n"
     "                            (`set unify`)\n"
@@ -49,7 +51,7 @@ namespace {
 
 /// The solver options of the command line, read before the scene is known.
 struct SolverArgs {
-    int order = -1, min_depth = -1, max_depth = -1, shots = -1, rays = -1;
+    int order = -1, min_depth = -1, max_depth = -1, shots = -1, rays = -1, shooter_level = -1;
     double convergence = -1, tolerance = -1;
     std::string shadows, unify, ambient, hidden;
     // Which options the command line gave: only those override the scene's `set` lines.
@@ -77,6 +79,7 @@ SolverArgs read_solver_args(Args& args, SceneRun& run) {
     a.tolerance = args.number("--tolerance", -1);
     a.shadows = args.text("--shadows", "exact");
     a.rays = args.integer("--rays", -1);
+    a.shooter_level = args.integer("--shooter-level", -1);
     a.unify = args.text("--unify", "projection");
     a.ambient = args.text("--ambient", "on");
     a.hidden = args.text("--hidden", "on");
@@ -97,6 +100,7 @@ SolverArgs read_solver_args(Args& args, SceneRun& run) {
     if (args.has("--convergence")) in_range("--convergence", a.convergence, 0, 1, false, true);
     if (a.has_tolerance) in_range("--tolerance", a.tolerance, 0, 1, true, true);
     if (args.has("--rays")) in_range("--rays", a.rays, 1, 4096);
+    if (args.has("--shooter-level")) in_range("--shooter-level", a.shooter_level, 0, 12);
     if (args.has("--threads")) in_range("--threads", run.threads, 1, 256);
     if (a.shadows != "exact" && a.shadows != "paper" && a.shadows != "none")
         throw UsageError("--shadows must be exact, paper or none");
@@ -133,6 +137,7 @@ void finish_scene_run(const SolverArgs& a, SceneRun& run) {
                                     : a.shadows == "paper" ? ShadowMethod::Fractions
                                                            : ShadowMethod::None;
     if (a.rays > 0) o.receiver.shadows.rays_per_patch = a.rays;
+    if (a.shooter_level >= 0) o.shooter_level = a.shooter_level;
     if (a.has_ambient) o.ambient = a.ambient == "on";
     if (a.has_unify) o.receiver.unify_by_projection = a.unify == "projection";
     if (a.has_hidden) o.hidden_regions = a.hidden == "on";
