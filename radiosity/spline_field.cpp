@@ -137,36 +137,51 @@ PolynomialPatches::PolynomialPatches(const SplineField& field) {
     for (int j = 0; j < cells_; ++j)
         for (int i = 0; i < cells_; ++i)
             for (int ch = 0; ch < 3; ++ch) {
-                double* C = &c_[((size_t(j) * cells_ + i) * 3 + ch) * m * m];
+                double* C = &c_[(size_t(j) * cells_ + i) * 3 * m * m];
                 for (int r = 0; r < m; ++r)
                     for (int r2 = 0; r2 < m; ++r2) {
                         const double a = field.coefficient(i - r, j - r2)[ch];
                         if (a == 0) continue;
                         for (int p = 0; p < m; ++p)
                             for (int q = 0; q < m; ++q)
-                                C[p * m + q] += a * P[size_t(r) * m + p] * P[size_t(r2) * m + q];
+                                C[(p * m + q) * 3 + ch] +=
+                                    a * P[size_t(r) * m + p] * P[size_t(r2) * m + q];
                     }
             }
 }
+
+namespace {
+
+/// Horner's rule in both directions on one cell's m x m x 3 coefficients (channel innermost),
+/// the three channels at once; M > 0 fixes the order at compile time (the common m = 4).
+template <int M>
+Rgb horner_cell(const double* C, int m_runtime, double lx, double ly) {
+    const int m = M > 0 ? M : m_runtime;
+    double v0 = 0, v1 = 0, v2 = 0;
+    for (int p = m - 1; p >= 0; --p) {
+        double r0 = 0, r1 = 0, r2 = 0;
+        for (int q = m - 1; q >= 0; --q) {
+            const double* c = C + (p * m + q) * 3;
+            r0 = r0 * ly + c[0];
+            r1 = r1 * ly + c[1];
+            r2 = r2 * ly + c[2];
+        }
+        v0 = v0 * lx + r0;
+        v1 = v1 * lx + r1;
+        v2 = v2 * lx + r2;
+    }
+    return {v0, v1, v2};
+}
+
+}  // namespace
 
 Rgb PolynomialPatches::operator()(double s, double t) const {
     if (c_.empty()) return {};
     const double x = std::clamp(s, 0.0, 1.0) * cells_, y = std::clamp(t, 0.0, 1.0) * cells_;
     const int i = std::min(cells_ - 1, static_cast<int>(x)), j = std::min(cells_ - 1, static_cast<int>(y));
     const double lx = x - i, ly = y - j;
-    const int m = m_;
-    Rgb out;
-    for (int ch = 0; ch < 3; ++ch) {
-        const double* C = &c_[((size_t(j) * cells_ + i) * 3 + ch) * m * m];
-        double value = 0;
-        for (int p = m - 1; p >= 0; --p) {
-            double row = 0;
-            for (int q = m - 1; q >= 0; --q) row = row * ly + C[p * m + q];
-            value = value * lx + row;
-        }
-        out[ch] = value;
-    }
-    return out;
+    const double* C = &c_[(size_t(j) * cells_ + i) * 3 * m_ * m_];
+    return m_ == 4 ? horner_cell<4>(C, 4, lx, ly) : horner_cell<0>(C, m_, lx, ly);
 }
 
 bool SplineField::is_constant() const {

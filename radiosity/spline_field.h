@@ -76,7 +76,7 @@ public:
 
 private:
     int m_ = 0, cells_ = 0;
-    std::vector<double> c_;  // cell (i, j), channel ch: c_[((j * cells + i) * 3 + ch) * m * m + p * m + q]
+    std::vector<double> c_;  // cell (i, j), x^p y^q, channel ch: c_[(j * cells + i) * 3 m^2 + (p m + q) 3 + ch]
 };
 
 }  // namespace mbr
