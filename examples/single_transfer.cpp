@@ -34,7 +34,7 @@ std::string usage() {
                "  --grid N                  error grid, 2..4096 (default 256)\n"
                "  --csv                     header rea_percent,max_rel_percent,leaves,coefficients,\n"
                "                            kernel_evals,seconds\n") +
-           mbr::receiver_options_usage;
+           mbr::receiver_options_usage + mbr::memory_budget_usage;
 }
 
 mbr::Surface read_quad(mbr::Args& args, const std::string& name, const mbr::Surface& fallback) {

@@ -265,6 +265,18 @@ Box3 Surface::bounds() const {
     return box;
 }
 
+long Surface::facet_count(int resolution) const {
+    MBR_CHECK(resolution >= 1);
+    if (kind_ == Kind::PlanarQuad) return 1;
+    // The same counts as tessellate() below.
+    const bool angular_u = kind_ == Kind::Cylinder || kind_ == Kind::Sphere;
+    const bool angular_v = kind_ == Kind::Sphere || kind_ == Kind::Disk;
+    const bool straight_u = kind_ == Kind::Disk, straight_v = kind_ == Kind::Cylinder;
+    const long n_u = straight_u ? 1 : (angular_u ? std::max(resolution, 3) : resolution);
+    const long n_v = straight_v ? 1 : (angular_v ? std::max(resolution, 3) : resolution);
+    return (kind_ == Kind::BilinearPatch ? 2 : 1) * n_u * n_v;
+}
+
 std::vector<Facet> Surface::tessellate(int resolution) const {
     MBR_CHECK(resolution >= 1);
     std::vector<Facet> facets;

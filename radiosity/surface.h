@@ -73,6 +73,9 @@ public:
     /// disk's radius), where the facets are exact. Planar quads are always one facet; bilinear
     /// patches give two triangles per cell because their cells are not planar.
     std::vector<Facet> tessellate(int resolution) const;
+    /// An upper bound of tessellate(resolution).size() (cells collapsed at a pole are dropped
+    /// there), without building the facets: a cost estimate before the octree is built.
+    long facet_count(int resolution) const;
     /// The four corners for quads, in (0,0), (1,0), (1,1), (0,1) order.
     const Vec3* corners() const { return p_; }
 

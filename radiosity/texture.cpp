@@ -133,6 +133,13 @@ Texture Texture::image(const std::string& path, Rgb scale) {
     return from_shared(std::move(pixels), scale, path);
 }
 
+long Texture::texel_bytes() const {
+    if (!pixels_) return 0;
+    const long n = long(pixels_->width) * pixels_->height;
+    // The 8-bit codes stb_image decoded (3 a texel) or the linear values (24 a texel).
+    return pixels_->srgb ? 3 * n : long(sizeof(Rgb)) * n;
+}
+
 Texture Texture::scaled(Rgb scale) const {
     Texture t = *this;
     t.a_ = a_ * scale;

@@ -65,6 +65,10 @@ public:
         return pixels_ != nullptr && pixels_ == other.pixels_;
     }
 
+    /// Bytes of the texel storage (shared by every texture that shares_texels() with this one);
+    /// 0 for the procedural kinds.
+    long texel_bytes() const;
+
 private:
     // Unscaled texels, row 0 at the top (v = 1), in one of two forms: linear values (from_pixels)
     // or the file's 8-bit sRGB codes with their 256 decoded values (image: 3 bytes a texel

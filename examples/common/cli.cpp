@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cctype>
 #include <cerrno>
 #include <chrono>
 #include <cmath>
@@ -16,6 +17,7 @@
 #include <streambuf>
 
 #include "math/check.h"
+#include "radiosity/cost.h"
 #include "radiosity/output_file.h"
 
 namespace mbr {
@@ -80,6 +82,54 @@ double parse_number(const std::string& text, const std::string& what) {
         throw UsageError(what + " expects a number, got '" + text + "'");
     if (!std::isfinite(v)) throw UsageError(what + " must be finite, got '" + text + "'");
     return v;
+}
+
+double parse_memory_size(const std::string& text, const std::string& what) {
+    std::string number = text;
+    double unit = 1;
+    // Strip an optional "B", then "i", then the power letter.
+    auto ends_with = [&](char c) {
+        return !number.empty() && std::tolower(static_cast<unsigned char>(number.back())) == c;
+    };
+    if (ends_with('b')) number.pop_back();
+    const bool binary = ends_with('i');
+    if (binary) number.pop_back();
+    const std::string powers = "kmgt";
+    if (!number.empty()) {
+        const size_t p = powers.find(char(std::tolower(static_cast<unsigned char>(number.back()))));
+        if (p != std::string::npos) {
+            unit = std::ldexp(1.0, 10 * int(p + 1));
+            number.pop_back();
+        } else if (binary) {
+            number = "";  // "iB" without a power letter
+        }
+    }
+    const char* begin = number.c_str();
+    char* end = nullptr;
+    const double v = std::strtod(begin, &end);
+    if (number.empty() || end != begin + number.size() || !std::isfinite(v) || !(v > 0))
+        throw UsageError(what + " expects a positive size in bytes, with K, M, G or T for powers "
+                                "of 1024 (e.g. 4G), got '" + text + "'");
+    return v * unit;
+}
+
+const char* memory_budget_usage =
+    "  --memory-budget X         refuse a run estimated to need more memory (bytes, or K, M,\n"
+    "                            G, T: 4G; default half the physical memory)\n";
+
+double read_memory_budget(Args& args) {
+    if (!args.has("--memory-budget")) return default_memory_budget();
+    return parse_memory_size(args.text("--memory-budget", ""), "--memory-budget");
+}
+
+void check_cost(const CostEstimate& cost, double budget, const std::string& run, bool slow) {
+    if (cost.bytes > budget)
+        throw UsageError(run + " needs about " + format_bytes(cost.bytes) + " (" + cost.detail +
+                         "), more than the memory budget of " + format_bytes(budget) +
+                         ": lower the depth, or raise --memory-budget");
+    if (slow)
+        std::cerr << "warning: " << run << " is slow: expect about " << format_bytes(cost.bytes)
+                  << " of memory and " << format_seconds(cost.seconds) << " of one core\n";
 }
 
 double Args::number(const std::string& name, double def) {

@@ -64,6 +64,20 @@ private:
 /// Parses a whole string as a finite double; UsageError naming `what` otherwise.
 double parse_number(const std::string& text, const std::string& what);
 
+/// A memory size: bytes, or a number with the suffix K, M, G or T (powers of 1024, an optional
+/// "B" or "iB" after it): "4G", "512MiB", "1.5g", "100000". UsageError naming `what` otherwise.
+double parse_memory_size(const std::string& text, const std::string& what);
+
+struct CostEstimate;
+/// Usage line of --memory-budget.
+extern const char* memory_budget_usage;
+/// "--memory-budget X" (parse_memory_size), default default_memory_budget() (radiosity/cost.h).
+double read_memory_budget(Args& args);
+/// Says the cost before it is spent: UsageError "<run> needs about N, more than the memory
+/// budget B ..." when cost.bytes exceeds the budget; otherwise, when `slow`, one warning line on
+/// stderr with the expected memory and time.
+void check_cost(const CostEstimate& cost, double budget, const std::string& run, bool slow);
+
 /// A results table: printed aligned for people, or as CSV with the exact column names.
 class Table {
 public:

@@ -12,6 +12,7 @@
 
 #include "math/check.h"
 #include "math/parallel.h"
+#include "radiosity/cost.h"
 #include "radiosity/image.h"
 #include "radiosity/output_file.h"
 #include "radiosity/scene_io.h"
@@ -45,7 +46,9 @@ const char* solver_options_usage =
     "  --hidden on|off           hidden regions take their visible neighbours' values\n"
     "                            (`set hidden`, default on)\n"
     "  --threads n               OpenMP threads, 1..256 (default: all cores)\n"
-    "  --quiet                   no progress bar\n";
+    "  --quiet                   no progress bar\n"
+    "  --memory-budget X         refuse a run estimated to need more memory (bytes, or K, M,\n"
+    "                            G, T: 4G; default half the physical memory)\n";
 
 namespace {
 
@@ -53,6 +56,7 @@ namespace {
 struct SolverArgs {
     int order = -1, min_depth = -1, max_depth = -1, shots = -1, rays = -1, shooter_level = -1;
     double convergence = -1, tolerance = -1;
+    double memory_budget = 0;
     std::string shadows, unify, ambient, hidden;
     // Which options the command line gave: only those override the scene's `set` lines.
     bool has_min_depth = false, has_max_depth = false, has_tolerance = false,
@@ -85,6 +89,7 @@ SolverArgs read_solver_args(Args& args, SceneRun& run) {
     a.hidden = args.text("--hidden", "on");
     run.threads = args.integer("--threads", 0);
     run.quiet = args.flag("--quiet");
+    a.memory_budget = read_memory_budget(args);
     a.has_min_depth = args.has("--min-depth");
     a.has_max_depth = args.has("--max-depth");
     a.has_tolerance = args.has("--tolerance");
@@ -144,6 +149,13 @@ void finish_scene_run(const SolverArgs& a, SceneRun& run) {
 #ifdef _OPENMP
     if (run.threads > 0) omp_set_num_threads(run.threads);
 #endif
+    // The cost is said before it is spent: before the octree and the solve allocate.
+    const int d = o.receiver.max_depth;
+    check_cost(scene_cost(run.scene, o, thread_count()), a.memory_budget,
+               run.path + " (" + std::to_string(run.scene.surfaces.size()) +
+                   " surfaces, max depth " + std::to_string(d) + ", tessellation " +
+                   std::to_string(run.scene.settings.tessellation) + ")",
+               d >= slow_receiver_depth);
     run.octree = std::make_unique<Octree>(build_octree(run.scene));
 }
 

@@ -3,6 +3,8 @@
 
 #include <sstream>
 
+#include "radiosity/cost.h"
+
 namespace mbr {
 
 const char* receiver_options_usage =
@@ -72,6 +74,12 @@ ReceiverOptions read_tree_options(Args& args, ReceiverOptions o) {
     }
     if (o.min_depth > o.max_depth) throw UsageError("--min-depth must not exceed --max-depth");
     if (!(o.oracle_tolerance > 0)) throw UsageError("--oracle-tolerance must be positive");
+    // The cost is said before it is spent: a full tree at the deepest depth allowed.
+    const double budget = read_memory_budget(args);
+    check_cost(transfer_cost(o), budget,
+               adaptive ? "an adaptive transfer up to depth " + std::to_string(o.max_depth)
+                        : "a transfer at depth " + std::to_string(o.max_depth),
+               o.max_depth >= slow_receiver_depth);
     return o;
 }
 

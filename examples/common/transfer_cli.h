@@ -22,7 +22,9 @@ ReceiverOptions read_receiver_options(Args& args);
 /// (the oracle of section 6) with --oracle-tolerance T and --min-depth a --max-depth b (0..12,
 /// default 1 and 6). Each mode refuses the other's options with a UsageError instead of
 /// ignoring them ("--depth has no effect with --adaptive"). Returns base with min_depth,
-/// max_depth and oracle_tolerance set.
+/// max_depth and oracle_tolerance set. Also reads --memory-budget (memory_budget_usage) and
+/// refuses, before anything is allocated, a tree whose estimated memory exceeds it
+/// (radiosity/cost.h); a depth of slow_receiver_depth or more prints one warning on stderr.
 ReceiverOptions read_tree_options(Args& args, ReceiverOptions base);
 
 /// A one-line description of the options that matter for the tables.
