@@ -31,14 +31,20 @@ inline int thread_count() {
 #endif
 }
 
-/// body(i) for i = 0 .. n-1 in parallel, items handed out one at a time (dynamic schedule);
-/// rethrows the exception of the lowest failing i once every item has run or failed.
-template <class Body>
-void parallel_for(int n, Body&& body) {
+/// body(i) for i = 0 .. n-1 in parallel, items handed out one at a time (dynamic schedule), on
+/// `threads` threads (0: OpenMP's default); rethrows the exception of the lowest failing i once
+/// every item has run or failed. Index is int or long.
+template <class Index, class Body>
+void parallel_for(Index n, Body&& body, int threads = 0) {
     std::vector<std::exception_ptr> errors;
     bool failed = false;
-#pragma omp parallel for schedule(dynamic, 1)
-    for (int i = 0; i < n; ++i) {
+#ifdef _OPENMP
+    const int n_threads = threads > 0 ? threads : omp_get_max_threads();
+#else
+    (void)threads;
+#endif
+#pragma omp parallel for schedule(dynamic, 1) num_threads(n_threads)
+    for (Index i = 0; i < n; ++i) {
         try {
             body(i);
         } catch (...) {

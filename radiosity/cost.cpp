@@ -12,7 +12,6 @@
 #include <vector>
 
 #include "math/check.h"
-#include "octree/polygon.h"
 
 namespace mbr {
 
@@ -31,14 +30,11 @@ constexpr double bytes_per_sample = sizeof(Rgb);
 // two busy cores, ~2e-4 s a leaf. A rough figure for a warning, nothing more.
 constexpr double seconds_per_leaf = 2e-4;
 
-/// Bytes of one polygon of the octree: the object, its vertices, uv and bounding planes, the
-/// facet it was made from, and its share of the octree (references from several leaves, nodes).
-double polygon_bytes(int n_vertices) {
-    const double own = sizeof(Polygon) + n_vertices * (sizeof(Vec3) + sizeof(Vec2) + sizeof(Plane));
-    const double facet = n_vertices * (sizeof(Vec3) + sizeof(Vec2)) + 64;
-    const double octree = 128;             // DESIGN: ~8 leaf references and a share of the nodes
-    return own + 3 * 16 + facet + octree;  // 16: the allocator's overhead per vector
-}
+// Calibration of the polygons (octree_stats examples/scenes/room.scene --tessellation T
+// --rays 1000, peak resident size): 6,984 KB at T = 24 (2,558 polygons), 65,540 KB at T = 128
+// (66,830), 249,152 KB at T = 256 (264,718): about 930-945 bytes a polygon, counting the
+// facets, the polygons with their planes, and the octree's references and nodes.
+constexpr double bytes_per_polygon = 960;
 
 }  // namespace
 
@@ -82,9 +78,7 @@ CostEstimate scene_cost(const Scene& scene, const SolverOptions& options, int th
     const double transfers = at_once * transfer_bytes(m, d);
     double polygons = 0;
     for (const SceneSurface& s : scene.surfaces) {
-        const bool triangles = s.surface.kind() == Surface::Kind::BilinearPatch;
-        polygons += double(s.surface.facet_count(scene.settings.tessellation)) *
-                    polygon_bytes(triangles ? 3 : 4);
+        polygons += double(s.surface.facet_count(scene.settings.tessellation)) * bytes_per_polygon;
     }
     // Each distinct texel storage once: materials sharing an image share its texels.
     std::vector<const Texture*> seen;

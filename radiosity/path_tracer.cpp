@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "math/check.h"
+#include "math/parallel.h"
 
 #ifdef _OPENMP
 #include <omp.h>
@@ -333,8 +334,7 @@ std::vector<RadiosityEstimate> estimate_radiosity(const Scene& scene, const Octr
     const long n_blocks = (options.paths + options.paths_per_block - 1) / options.paths_per_block;
     const long n_items = static_cast<long>(points.size()) * n_blocks;
     std::vector<Moments> blocks(n_items);
-#pragma omp parallel for schedule(dynamic, 1) num_threads(thread_count(options.threads))
-    for (long item = 0; item < n_items; ++item) {
+    parallel_for(n_items, [&](long item) {
         const long point = item / n_blocks, block = item % n_blocks;
         const long first = block * options.paths_per_block;
         const long last = std::min(options.paths, first + options.paths_per_block);
@@ -345,7 +345,7 @@ std::vector<RadiosityEstimate> estimate_radiosity(const Scene& scene, const Octr
             moments.add(trace_path(ctx, points[point], options.min_bounces_before_roulette, rng));
         }
         blocks[item] = moments;
-    }
+    }, thread_count(options.threads));
 
     std::vector<RadiosityEstimate> estimates(points.size());
     for (size_t point = 0; point < points.size(); ++point) {

@@ -7,6 +7,7 @@
 #include "math/convex2d.h"
 
 #include "math/check.h"
+#include "math/parallel.h"
 #include "radiosity/kernel.h"
 
 namespace mbr {
@@ -33,12 +34,12 @@ TransferSetup perpendicular_squares() {
 std::vector<double> exact_grid(const TransferSetup& setup, int n, double scale) {
     const std::vector<Vec3> polygon = setup.shooter_polygon();
     std::vector<double> out(size_t(n) * n);
-#pragma omp parallel for schedule(static)
-    for (int j = 0; j < n; ++j)
+    parallel_for(n, [&](int j) {
         for (int i = 0; i < n; ++i) {
             const SurfacePoint p = setup.receiver.evaluate((i + 0.5) / n, (j + 0.5) / n);
             out[size_t(j) * n + i] = scale * point_polygon_form_factor(p.position, p.normal, polygon);
         }
+    });
     return out;
 }
 
@@ -99,8 +100,7 @@ std::vector<double> exact_shadowed_grid(const ShadowSetup& setup, int n) {
     const Vec3* c = setup.shooter.corners();
     const std::vector<Vec3> shooter{c[0], c[1], c[2], c[3]};
     std::vector<double> out(size_t(n) * n);
-#pragma omp parallel for schedule(static)
-    for (int j = 0; j < n; ++j)
+    parallel_for(n, [&](int j) {
         for (int i = 0; i < n; ++i) {
             const SurfacePoint p = setup.receiver.evaluate((i + 0.5) / n, (j + 0.5) / n);
             double f = point_polygon_form_factor(p.position, p.normal, shooter);
@@ -109,14 +109,15 @@ std::vector<double> exact_shadowed_grid(const ShadowSetup& setup, int n) {
                      shadowed_form_factor(p.position, p.normal, shooter, o);
             out[size_t(j) * n + i] = f;
         }
+    });
     return out;
 }
 
 std::vector<double> field_grid(const SplineField& field, int n) {
     std::vector<double> out(size_t(n) * n);
-#pragma omp parallel for schedule(static)
-    for (int j = 0; j < n; ++j)
+    parallel_for(n, [&](int j) {
         for (int i = 0; i < n; ++i) out[size_t(j) * n + i] = field.evaluate((i + 0.5) / n, (j + 0.5) / n).r;
+    });
     return out;
 }
 

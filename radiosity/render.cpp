@@ -12,6 +12,7 @@
 #include <unordered_map>
 
 #include "math/check.h"
+#include "math/parallel.h"
 #include "radiosity/texture.h"
 
 namespace mbr {
@@ -335,8 +336,7 @@ Image render_radiance(const Scene& scene, const Octree& octree,
 
     Image image(width, height);
     std::vector<RenderStats> row_stats(height);  // summed in row order after the loop
-#pragma omp parallel for schedule(dynamic)
-    for (int y = 0; y < height; ++y) {
+    parallel_for(height, [&](int y) {
         for (int x = 0; x < width; ++x) {
             PixelRng rng(options.seed, x, y);
             Rgb sum;
@@ -351,7 +351,7 @@ Image render_radiance(const Scene& scene, const Octree& octree,
             }
             image.at(x, y) = (1.0 / spp) * sum;
         }
-    }
+    });
     if (stats) {
         *stats = RenderStats{};
         for (const RenderStats& s : row_stats) *stats += s;
@@ -394,8 +394,7 @@ void draw_quadtree_overlay(Image& display, const Scene& scene, const Octree& oct
     };
     std::vector<Seen> seen(size_t(width) * height);
     std::vector<RenderStats> row_stats(height);
-#pragma omp parallel for schedule(dynamic)
-    for (int y = 0; y < height; ++y)
+    parallel_for(height, [&](int y) {
         for (int x = 0; x < width; ++x) {
             const std::optional<FrontHit> hit =
                 front_hit(octree, camera.ray(x + 0.5, y + 0.5), &row_stats[y]);
@@ -403,6 +402,7 @@ void draw_quadtree_overlay(Image& display, const Scene& scene, const Octree& oct
                 seen[size_t(y) * width + x] = {hit->surface,
                                                lookup[hit->surface].find(hit->u, hit->v)};
         }
+    });
     for (int y = 0; y < height; ++y)
         for (int x = 0; x < width; ++x) {
             const Seen& here = seen[size_t(y) * width + x];
