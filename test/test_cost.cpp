@@ -2,7 +2,9 @@
 // radiosity/cost.h grows with every setting and refuses a run over the budget; an image named by
 // several materials is counted (and decoded) once; a failure inside a parallel loop reaches the
 // caller as an exception; coarsening a deep shooter by every number of levels works.
+#include <algorithm>
 #include <catch2/catch.hpp>
+#include <iostream>
 #include <sstream>
 #include <stdexcept>
 
@@ -80,6 +82,19 @@ TEST_CASE("cost: a run over the memory budget is refused before it starts", "[co
         FAIL("depth 10 within 64 MiB was accepted");
     } catch (const UsageError& e) {
         CHECK_THAT(e.what(), Catch::Contains("more than the memory budget of 64.0 MiB"));
+    }
+
+    // Valid but slow: one warning line on stderr with the memory and the time.
+    {
+        std::ostringstream err;
+        std::streambuf* old = std::cerr.rdbuf(err.rdbuf());
+        o.min_depth = o.max_depth = slow_receiver_depth;
+        check_cost(transfer_cost(o), 1e12, "a transfer at depth 9", true);
+        std::cerr.rdbuf(old);
+        CHECK_THAT(err.str(),
+                   Catch::StartsWith("warning: a transfer at depth 9 is slow: expect about"));
+        const std::string line = err.str();
+        CHECK(std::count(line.begin(), line.end(), '\n') == 1);
     }
 
     CHECK(parse_memory_size("4G", "x") == 4.0 * (1L << 30));
