@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <limits>
 #include <cmath>
 #include <set>
 
@@ -135,6 +136,43 @@ void IncrementSampler::sample_pair(double s, double t, double ds, double dt, int
 
 // ---- Stage 1: oracle subdivision ---------------------------------------------------------
 
+namespace {
+
+/// Distance from x to a planar shooter's closed polygon (its frame and outline).
+double distance_to_shooter(const ShooterPlane& plane, Vec3 x) {
+    const double height = dot(x - plane.origin, plane.normal);
+    const Vec2 q = plane.to_plane(x);
+    double across = 0;
+    if (!contains(plane.outline, q)) {
+        across = std::numeric_limits<double>::infinity();
+        const size_t n = plane.outline.size();
+        for (size_t k = 0; k < n; ++k) {
+            const Vec2 a = plane.outline[k], b = plane.outline[(k + 1) % n];
+            const Vec2 e = b - a;
+            const double len2 = dot(e, e);
+            const double t = len2 > 0 ? std::clamp(dot(q - a, e) / len2, 0.0, 1.0) : 0.0;
+            const Vec2 d = q - (a + t * e);
+            across = std::min(across, std::sqrt(dot(d, d)));
+        }
+    }
+    return std::sqrt(height * height + across * across);
+}
+
+/// True when the receiver's cell comes within half its size of a planar shooter: its corners,
+/// edge midpoints and centre are tested (the contact lines of scenes are straight).
+bool touches_shooter(const Surface& receiver, const ShooterPlane& plane, const Rect& r) {
+    Vec3 p[9];
+    int k = 0;
+    for (double t : {r.y0, 0.5 * (r.y0 + r.y1), r.y1})
+        for (double s : {r.x0, 0.5 * (r.x0 + r.x1), r.x1}) p[k++] = receiver.evaluate(s, t).position;
+    const double size = std::max(length(p[8] - p[0]), length(p[6] - p[2]));
+    for (const Vec3& x : p)
+        if (distance_to_shooter(plane, x) <= 0.5 * size) return true;
+    return false;
+}
+
+}  // namespace
+
 void subdivide_by_oracle(ReceiverState& state, IncrementSampler& sampler) {
     const ReceiverOptions& opt = state.options;
     const int m = opt.m;
@@ -212,6 +250,10 @@ void subdivide_by_oracle(ReceiverState& state, IncrementSampler& sampler) {
     if (opt.weak_receiver > 0 && opt.absolute_tolerance > 0 && scale < opt.weak_receiver * opt.absolute_tolerance)
         min_depth = 0;
 
+    // The shooter's plane when it is planar (the contact rule of ReceiverOptions::contact_depth).
+    const ShooterPlane* contact_plane =
+        opt.contact_depth > 0 ? sampler.integrator(0).shooter_plane() : nullptr;
+
     enum Action { Leaf, Split, SplitOnceMore };
     std::vector<int> frontier{forest.domain_root()};
     while (!frontier.empty()) {
@@ -221,6 +263,11 @@ void subdivide_by_oracle(ReceiverState& state, IncrementSampler& sampler) {
         parallel_for(n, [&](int c) {
             const DyadicCell cell = forest.node(frontier[c]).cell;
             if (cell.level < min_depth) {
+                action[c] = Split;
+                return;
+            }
+            if (cell.level < opt.contact_depth && contact_plane &&
+                touches_shooter(*sampler.receiver().surface, *contact_plane, cell.rect())) {
                 action[c] = Split;
                 return;
             }

@@ -91,6 +91,11 @@ struct ReceiverOptions {
                                        //   of refining coarse ones by (17) (not the paper's rule)
     QuadratureOptions quadrature;      // the adaptive rule over the shooter, section 6
     ShadowOptions shadows;             // stage 7 (used when the transfer has occluders)
+    int contact_depth = 0;             // beyond the paper: a cell that touches a planar shooter
+                                       //   (within half its own size) splits down to this level,
+                                       //   whatever the oracle says: along an edge shared with
+                                       //   the shooter dB grows like d log d, whose cell means
+                                       //   agree long before the spline can follow it (0: off)
     double weak_receiver = 0;          // > 0: a receiver whose root samples are all below this
                                        //   many absolute tolerances starts the oracle at depth 0
     double oracle_share = 1;           // the oracle's absolute tolerance: this share of

@@ -63,6 +63,8 @@ struct SolverSettings {
     bool hidden = true;                    // hidden regions take their visible neighbours' values
     int shooter_level = 5;                 // a shooter's unshot field coarsened to at most this
                                            //   level (section 6's "lower resolution version")
+    int contact_depth = 2;                 // receiver cells touching a planar shooter split to
+                                           //   at least this level (0: off)
 };
 
 /// A whole scene. Surface i's material is materials[surfaces[i].material].

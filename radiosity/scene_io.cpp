@@ -1365,6 +1365,8 @@ private:
             s.unify = value;
         } else if (key == "shooter_level") {
             s.shooter_level = integer(0, 12);
+        } else if (key == "contact_depth") {
+            s.contact_depth = integer(0, 12);
         } else if (key == "ambient" || key == "hidden") {
             if (value != "true" && value != "false")
                 line.fail(key + " " + in_quotes(value) + " is neither 'true' nor 'false'");
@@ -1374,7 +1376,7 @@ private:
                       " (known: order, min_depth, max_depth, oracle_tolerance, truncation_eps, "
                       "rhombus_radius, extrapolation, shadow_rays, max_shots, convergence, "
                       "self_transfer, tessellation, shadows, tolerance, unify, ambient, hidden, "
-                      "shooter_level)");
+                      "shooter_level, contact_depth)");
         }
     }
 

@@ -98,6 +98,10 @@ SolverOptions solver_options(const SolverSettings& s) {
     // part's triangles use 3 against 4 points, edgefill stops 2 levels below the finest
     // boundary leaf.
     o.receiver.weak_receiver = 10;
+    // DESIGN: cells touching a planar shooter split to contact_depth (2) whatever the oracle
+    // says (ReceiverOptions::contact_depth; measured on the cubes and the Cornell box,
+    // docs/method.md).
+    o.receiver.contact_depth = s.contact_depth;
     o.receiver.quadrature.n_pieces = 3;
     o.receiver.edgefill_max_depth = 2;
     o.receiver.m = s.order;

@@ -1288,3 +1288,41 @@ TEST_CASE("receiver: Table 2 row d = 3 stays below the paper's 0.676 %", "[recei
     mbr::test::report() << "receiver Table 2 d=3: rea " << 100 * e.rea << " % (paper 0.676 %), max "
                         << 100 * e.max_rel << " %\n";
 }
+
+TEST_CASE("receiver: cells touching the shooter split down to contact_depth, and only those",
+          "[receiver]") {
+    // Perpendicular squares share the edge y = 0. With a loose oracle the tree stays shallow;
+    // contact_depth 3 must take every domain leaf on the shared edge to level 3 or deeper,
+    // while leaves away from it stay coarser (the rule is local). Without the rule the edge's
+    // leaves stay shallow too, so the check can fail.
+    ReceiverOptions options;
+    options.min_depth = 0;
+    options.max_depth = 4;
+    options.oracle_tolerance = 0.5;
+    auto edge_and_far_levels = [&](int contact_depth) {
+        options.contact_depth = contact_depth;
+        const Run run = run_transfer(perpendicular_squares(), options);
+        int edge_min = 99, far_min = 99;
+        for (int index : run.state.forest.leaves(Forest::Region::Domain)) {
+            const DyadicCell c = run.state.forest.node(index).cell;
+            const Rect r = c.rect();
+            double lowest_y = 1e300;
+            for (double s : {r.x0, r.x1})
+                for (double t : {r.y0, r.y1})
+                    lowest_y = std::min(lowest_y,
+                                        std::fabs(run.setup.receiver.evaluate(s, t).position.y));
+            if (lowest_y == 0)
+                edge_min = std::min(edge_min, c.level);
+            else if (lowest_y >= 0.5)
+                far_min = std::min(far_min, c.level);
+        }
+        return std::pair{edge_min, far_min};
+    };
+    const auto [edge_off, far_off] = edge_and_far_levels(0);
+    const auto [edge_on, far_on] = edge_and_far_levels(3);
+    test::report() << "contact_depth 0: shallowest edge leaf " << edge_off << ", far " << far_off
+                   << "; contact_depth 3: edge " << edge_on << ", far " << far_on << "\n";
+    CHECK(edge_off < 3);
+    CHECK(edge_on >= 3);
+    CHECK(far_on < 3);
+}

@@ -38,6 +38,8 @@ const char* solver_options_usage =
     "  --rays R                  paper shadows: rays per shooter patch, 1..4096\n"
     "  --shooter-level L         a shooter's unshot field is coarsened to at most level L,\n"
     "                            0..12 (scene's `set shooter_level`, default 5)\n"
+    "  --contact-depth D         receiver cells touching a planar shooter split to at least\n"
+    "                            level D, 0..12 (scene's `set contact_depth`, default 2)\n"
     "  --unify projection|paper  every finest coefficient projected on the fine grid\n"
     "                            (default), or the paper's (17) from selected fulcrums\n"
     "                            (`set unify`)\n"
@@ -54,7 +56,8 @@ namespace {
 
 /// The solver options of the command line, read before the scene is known.
 struct SolverArgs {
-    int order = -1, min_depth = -1, max_depth = -1, shots = -1, rays = -1, shooter_level = -1;
+    int order = -1, min_depth = -1, max_depth = -1, shots = -1, rays = -1, shooter_level = -1,
+        contact_depth = -1;
     double convergence = -1, tolerance = -1;
     double memory_budget = 0;
     std::string shadows, unify, ambient, hidden;
@@ -84,6 +87,7 @@ SolverArgs read_solver_args(Args& args, SceneRun& run) {
     a.shadows = args.text("--shadows", "exact");
     a.rays = args.integer("--rays", -1);
     a.shooter_level = args.integer("--shooter-level", -1);
+    a.contact_depth = args.integer("--contact-depth", -1);
     a.unify = args.text("--unify", "projection");
     a.ambient = args.text("--ambient", "on");
     a.hidden = args.text("--hidden", "on");
@@ -106,6 +110,7 @@ SolverArgs read_solver_args(Args& args, SceneRun& run) {
     if (a.has_tolerance) in_range("--tolerance", a.tolerance, 0, 1, true, true);
     if (args.has("--rays")) in_range("--rays", a.rays, 1, 4096);
     if (args.has("--shooter-level")) in_range("--shooter-level", a.shooter_level, 0, 12);
+    if (args.has("--contact-depth")) in_range("--contact-depth", a.contact_depth, 0, 12);
     if (args.has("--threads")) in_range("--threads", run.threads, 1, 256);
     if (a.shadows != "exact" && a.shadows != "paper" && a.shadows != "none")
         throw UsageError("--shadows must be exact, paper or none");
@@ -143,6 +148,7 @@ void finish_scene_run(const SolverArgs& a, SceneRun& run) {
                                                            : ShadowMethod::None;
     if (a.rays > 0) o.receiver.shadows.rays_per_patch = a.rays;
     if (a.shooter_level >= 0) o.shooter_level = a.shooter_level;
+    if (a.contact_depth >= 0) o.receiver.contact_depth = a.contact_depth;
     if (a.has_ambient) o.ambient = a.ambient == "on";
     if (a.has_unify) o.receiver.unify_by_projection = a.unify == "projection";
     if (a.has_hidden) o.hidden_regions = a.hidden == "on";
