@@ -20,7 +20,9 @@
 // - solve_s        with --solve-shots K, for sizes up to --solve-max: the progressive solver
 //                  (radiosity/solver.h) at the scene's settings for exactly K shots (no
 //                  convergence stop, no ambient correction, so that every size does the same
-//                  number of shots), with its transfers, kernel evaluations and shadow rays.
+//                  number of shots), with its transfers, kernel evaluations and shadow rays;
+//                  shots_s is the time in the shots, setup_s the rest (the emission's
+//                  projection and the hidden-region masks of every surface, radiosity/hidden.h).
 //                  The lamp shoots first, then the brightest walls and block tops; each shot
 //                  reaches every surface in front of its shooter, so the transfers per shot, and
 //                  the cost of a linear method, grow in proportion to N.
@@ -67,8 +69,8 @@ const char* usage =
     "  boxes from an OBJ file, and reports per N the seconds to parse both, the seconds to\n"
     "  build the octree, its nodes and depth, and closest-hit and shadow rays per second.\n"
     "  --sizes N1,N2,...  numbers of quads, each 13..2000000 (default 1000,10000,100000,200000)\n"
-    "  --rays R           rays of each kind per size (default 100000)\n"
-    "  --seed S           seed of the random rays (default 1)\n"
+    "  --rays R           rays of each kind per size, 1..100000000 (default 100000)\n"
+    "  --seed S           seed of the random rays, 0..2147483647 (default 1)\n"
     "  --keep             keep the generated files (their folder is printed on stderr)\n"
     "  --solve-shots K    also solve each scene for exactly K shots, 0..1000 (default 0: no\n"
     "                     solve), and report the seconds, transfers, kernel evaluations and rays\n"
@@ -286,7 +288,7 @@ struct Row {
     double closest_per_s = 0, shadow_per_s = 0;
     double closest_hit_fraction = 0, shadow_hit_fraction = 0;
     bool solved = false;
-    double solve_s = 0;
+    double solve_s = 0, shots_s = 0;
     long transfers = 0, kernel_evals = 0, shadow_rays = 0;
 };
 
@@ -370,7 +372,10 @@ Row measure(const fs::path& dir, int n_quads, int n_rays, int seed, const SolveS
             });
         row.solve_s = mbr::now_seconds() - t0;
         row.solved = true;
-        for (const mbr::ShotStats& shot : solution.stats.per_shot) row.transfers += shot.receivers;
+        for (const mbr::ShotStats& shot : solution.stats.per_shot) {
+            row.transfers += shot.receivers;
+            row.shots_s += shot.seconds;
+        }
         row.kernel_evals = solution.stats.kernel_evals;
         row.shadow_rays = solution.stats.rays;
     }
@@ -397,8 +402,8 @@ int run(mbr::Args& args) {
     const bool csv = args.flag("--csv");
     const bool keep = args.flag("--keep");
     const std::vector<int> sizes = parse_sizes(args.text("--sizes", "1000,10000,100000,200000"));
-    const int n_rays = args.integer("--rays", 100000);
-    const int seed = args.integer("--seed", 1);
+    const int n_rays = args.integer("--rays", 100000, 1, 100000000);
+    const int seed = args.integer("--seed", 1, 0, 2147483647);
     SolveSettings solve;
     solve.shots = args.integer("--solve-shots", 0, 0, 1000);
     solve.max_quads = args.integer("--solve-max", 1000, 13, 2000000);
@@ -409,7 +414,6 @@ int run(mbr::Args& args) {
                               solve.shadows + "'");
     args.finish();
     if (!args.positional().empty()) throw mbr::UsageError("scene_scaling takes no file names");
-    if (n_rays < 1) throw mbr::UsageError("--rays must be at least 1");
 
     TempFolder dir;
     if (keep) {
@@ -434,7 +438,8 @@ int run(mbr::Args& args) {
                       "shadow_per_s",
                       "shadow_hits",
                       "solve_s",
-                      "solve_us_per_quad",
+                      "shots_s",
+                      "setup_s",
                       "transfers",
                       "kernel_evals",
                       "shadow_rays"});
@@ -459,7 +464,8 @@ int run(mbr::Args& args) {
                        mbr::cell_g(r.shadow_per_s, 3),
                        mbr::cell(r.shadow_hit_fraction, 3),
                        r.solved ? mbr::cell_g(r.solve_s, 3) : "",
-                       r.solved ? mbr::cell(1e6 * r.solve_s / quads, 1) : "",
+                       r.solved ? mbr::cell_g(r.shots_s, 3) : "",
+                       r.solved ? mbr::cell_g(r.solve_s - r.shots_s, 3) : "",
                        r.solved ? std::to_string(r.transfers) : "",
                        r.solved ? std::to_string(r.kernel_evals) : "",
                        r.solved ? std::to_string(r.shadow_rays) : ""});
