@@ -11,6 +11,7 @@
 // Exit status: 0 on success, 2 for bad usage or bad input, 1 for a failure while running; one
 // line on stderr. Output files are written under a temporary name and renamed.
 #include <algorithm>
+#include <cerrno>
 #include <cstring>
 #include <fstream>
 #include <iostream>
@@ -83,8 +84,14 @@ Solution obtain_solution(SceneRun& run, const std::string& load, const std::stri
                          bool report, std::ostream& summary) {
     Solution solution;
     if (!load.empty()) {
+        errno = 0;
         std::ifstream in(load);
-        if (!in) throw InputError(load, 0, "cannot open the solution file");
+        if (!in) {
+            const int err = errno;  // the system's reason, e.g. "Permission denied"
+            throw InputError(load, 0,
+                             std::string("cannot open the solution file") +
+                                 (err != 0 ? std::string(": ") + std::strerror(err) : ""));
+        }
         solution = load_solution(in, load, run.scene);
         if (report) summary << "loaded " << load << "\n";
     } else {

@@ -17,16 +17,30 @@
 //                  directions uniform on the sphere
 // - shadow_per_s   any_hit segments per second (one thread) between two points drawn uniformly
 //                  by area over all polygons, the ends excluded by 1e-6 of the segment
-// - solve_s        empty for now: the solver's cost will go here
+// - solve_s        with --solve-shots K, for sizes up to --solve-max: the progressive solver
+//                  (radiosity/solver.h) at the scene's settings for exactly K shots (no
+//                  convergence stop, no ambient correction, so that every size does the same
+//                  number of shots), with its transfers, kernel evaluations and shadow rays;
+//                  shots_s is the time in the shots, setup_s the rest (the emission's
+//                  projection and the hidden-region masks of every surface, radiosity/hidden.h).
+//                  The lamp shoots first, then the brightest walls and block tops; each shot
+//                  reaches every surface in front of its shooter, so the transfers per shot, and
+//                  the cost of a linear method, grow in proportion to N.
 // A cost per quad (seconds / N) that stays flat as N grows is linear behaviour.
 //
 // Run:    scene_scaling [--sizes 1000,10000,100000,200000] [--rays N] [--seed S] [--keep]
-//                       [--csv]
+//                       [--solve-shots K] [--solve-max N] [--solve-shadows M] [--csv]
 // Expect: parse and octree seconds close to proportional to N: about 3-8 microseconds per quad
 //         to parse and 1.5-5 to build the octree (200,000 quads: parse 1-1.5 s, octree 0.5-0.8 s
 //         on two shared cores; before name look-ups were hashed, parsing took 163 s). Ray rates
 //         fall slowly with N (about 3x from 1,000 to 200,000 quads: deeper trees, more cache
 //         misses).
+//         --solve-shots 3 (no shadows, two shared cores): 100, 300, 1000 quads take 1.3, 7.6,
+//         20 s in the shots (208, 618, 2034 transfers; kernel evaluations per transfer rise
+//         from 0.3 to 0.8 million up to 300 quads, then stay flat: the shots are linear once the
+//         floor's shooter partition is at its finest level) and 1.3, 6.7, 25 s in the setup
+//         (growing as N^1.3: the hidden-region masks). Shadows multiply the shot cost: 100
+//         quads, 2 shots take 3 s without, 84 s with paper shadows and over 5 minutes exact.
 #include <unistd.h>
 
 #include <algorithm>
@@ -46,6 +60,7 @@
 #include "octree/octree.h"
 #include "radiosity/scene_io.h"
 #include "radiosity/scene_octree.h"
+#include "radiosity/solver.h"
 
 namespace {
 
@@ -53,15 +68,21 @@ namespace fs = std::filesystem;
 using mbr::Vec3;
 
 const char* usage =
-    "usage: scene_scaling [--sizes N1,N2,...] [--rays R] [--seed S] [--keep] [--csv]\n"
+    "usage: scene_scaling [--sizes N1,N2,...] [--rays R] [--seed S] [--keep]\n"
+    "                     [--solve-shots K] [--solve-max N] [--solve-shadows M] [--csv]\n"
     "  Generates scenes of about N planar quads (a room with a grid of small boxes on its\n"
     "  floor), writes each as a .scene file of `quad` statements and as a scene importing the\n"
     "  boxes from an OBJ file, and reports per N the seconds to parse both, the seconds to\n"
     "  build the octree, its nodes and depth, and closest-hit and shadow rays per second.\n"
-    "  --sizes N1,N2,...  numbers of quads, each 7..2000000 (default 1000,10000,100000,200000)\n"
-    "  --rays R           rays of each kind per size (default 100000)\n"
-    "  --seed S           seed of the random rays (default 1)\n"
+    "  --sizes N1,N2,...  numbers of quads, each 13..2000000 (default 1000,10000,100000,200000)\n"
+    "  --rays R           rays of each kind per size, 1..100000000 (default 100000)\n"
+    "  --seed S           seed of the random rays, 0..2147483647 (default 1)\n"
     "  --keep             keep the generated files (their folder is printed on stderr)\n"
+    "  --solve-shots K    also solve each scene for exactly K shots, 0..1000 (default 0: no\n"
+    "                     solve), and report the seconds, transfers, kernel evaluations and rays\n"
+    "  --solve-max N      solve only the sizes up to N quads (default 1000; solving is the slow\n"
+    "                     part)\n"
+    "  --solve-shadows M  none (default), paper or exact: the solve's shadow method\n"
     "  --csv              one CSV row per size\n";
 
 // === Scene generation
@@ -272,9 +293,20 @@ struct Row {
     double references_per_polygon = 0;
     double closest_per_s = 0, shadow_per_s = 0;
     double closest_hit_fraction = 0, shadow_hit_fraction = 0;
+    bool solved = false;
+    double solve_s = 0, shots_s = 0;
+    long transfers = 0, kernel_evals = 0, shadow_rays = 0;
 };
 
-Row measure(const fs::path& dir, int n_quads, int n_rays, int seed) {
+/// What the solve column measures.
+struct SolveSettings {
+    int shots = 0;                 // 0: no solve
+    int max_quads = 0;             // sizes above this are not solved
+    bool progress = false;         // one line per shot on stderr
+    std::string shadows = "none";  // the scene setting `shadows`: none, paper or exact
+};
+
+Row measure(const fs::path& dir, int n_quads, int n_rays, int seed, const SolveSettings& solve) {
     Row row;
     row.n_quads = n_quads;
     const Layout layout = make_layout(n_quads);
@@ -327,8 +359,32 @@ Row measure(const fs::path& dir, int n_quads, int n_rays, int seed) {
     row.shadow_per_s = n_rays / (mbr::now_seconds() - t0);
     row.shadow_hit_fraction = double(n_hits) / n_rays;
 
-    // SOLVE HOOK: once the progressive solver exists, time it here on `scene` (a fixed number
-    // of shots, or to a fixed convergence) and fill the solve_s column in run() below.
+    if (solve.shots > 0 && n_quads <= solve.max_quads) {
+        mbr::SolverSettings settings = scene.settings;
+        settings.shadows = solve.shadows;
+        mbr::SolverOptions options = mbr::solver_options(settings);
+        options.max_shots = solve.shots;
+        options.convergence = 0;  // never stop early: the same number of shots at every size
+        options.ambient = false;  // its cost is not that of the paper's method
+        t0 = mbr::now_seconds();
+        const mbr::Solution solution = mbr::solve(
+            scene, octree, options, [&](const mbr::ShotStats& shot, const mbr::ProgressiveSolver&) {
+                if (solve.progress)
+                    std::cerr << "scene_scaling: " << n_quads << " quads, shot " << shot.shot
+                              << " from " << scene.surfaces[shot.shooter].name << ": "
+                              << shot.receivers << " transfers, " << shot.kernel_evals
+                              << " kernel evaluations, " << shot.rays << " rays, " << shot.seconds
+                              << " s\n";
+            });
+        row.solve_s = mbr::now_seconds() - t0;
+        row.solved = true;
+        for (const mbr::ShotStats& shot : solution.stats.per_shot) {
+            row.transfers += shot.receivers;
+            row.shots_s += shot.seconds;
+        }
+        row.kernel_evals = solution.stats.kernel_evals;
+        row.shadow_rays = solution.stats.rays;
+    }
     return row;
 }
 
@@ -338,8 +394,9 @@ std::vector<int> parse_sizes(const std::string& text) {
     std::string item;
     while (std::getline(ss, item, ',')) {
         const double x = mbr::parse_number(item, "--sizes");
-        if (x != std::floor(x) || x < 7 || x > 2000000)
-            throw mbr::UsageError("--sizes: each size must be an integer in 7..2000000, got '" +
+        // 13: the room, the lamp and one block (no block would leave the OBJ file empty).
+        if (x != std::floor(x) || x < 13 || x > 2000000)
+            throw mbr::UsageError("--sizes: each size must be an integer in 13..2000000, got '" +
                                   item + "'");
         sizes.push_back(static_cast<int>(x));
     }
@@ -351,33 +408,73 @@ int run(mbr::Args& args) {
     const bool csv = args.flag("--csv");
     const bool keep = args.flag("--keep");
     const std::vector<int> sizes = parse_sizes(args.text("--sizes", "1000,10000,100000,200000"));
-    const int n_rays = args.integer("--rays", 100000);
-    const int seed = args.integer("--seed", 1);
+    const int n_rays = args.integer("--rays", 100000, 1, 100000000);
+    const int seed = args.integer("--seed", 1, 0, 2147483647);
+    SolveSettings solve;
+    solve.shots = args.integer("--solve-shots", 0, 0, 1000);
+    solve.max_quads = args.integer("--solve-max", 1000, 13, 2000000);
+    solve.progress = !csv;
+    solve.shadows = args.text("--solve-shadows", "none");
+    if (solve.shadows != "none" && solve.shadows != "paper" && solve.shadows != "exact")
+        throw mbr::UsageError("--solve-shadows must be none, paper or exact, got '" +
+                              solve.shadows + "'");
     args.finish();
     if (!args.positional().empty()) throw mbr::UsageError("scene_scaling takes no file names");
-    if (n_rays < 1) throw mbr::UsageError("--rays must be at least 1");
 
     TempFolder dir;
     if (keep) {
         dir.keep();
         std::cerr << "scene_scaling: files kept in " << dir.path().string() << "\n";
     }
-    mbr::Table table({"quads", "surfaces", "file_MB", "parse_s", "parse_us_per_quad", "obj_parse_s",
-                      "octree_s", "octree_us_per_quad", "polygons", "nodes", "leaves", "depth",
-                      "refs_per_polygon", "closest_per_s", "closest_hits", "shadow_per_s",
-                      "shadow_hits", "solve_s"});
+    mbr::Table table({"quads",
+                      "surfaces",
+                      "file_MB",
+                      "parse_s",
+                      "parse_us_per_quad",
+                      "obj_parse_s",
+                      "octree_s",
+                      "octree_us_per_quad",
+                      "polygons",
+                      "nodes",
+                      "leaves",
+                      "depth",
+                      "refs_per_polygon",
+                      "closest_per_s",
+                      "closest_hits",
+                      "shadow_per_s",
+                      "shadow_hits",
+                      "solve_s",
+                      "shots_s",
+                      "setup_s",
+                      "transfers",
+                      "kernel_evals",
+                      "shadow_rays"});
     for (int n : sizes) {
-        const Row r = measure(dir.path(), n, n_rays, seed);
+        const Row r = measure(dir.path(), n, n_rays, seed, solve);
         const double quads = double(r.n_surfaces);
-        table.add_row({std::to_string(r.n_quads), std::to_string(r.n_surfaces),
-                       mbr::cell(r.megabytes, 2), mbr::cell_g(r.parse_s, 3),
-                       mbr::cell(1e6 * r.parse_s / quads, 2), mbr::cell_g(r.obj_parse_s, 3),
-                       mbr::cell_g(r.octree_s, 3), mbr::cell(1e6 * r.octree_s / quads, 2),
-                       std::to_string(r.n_polygons), std::to_string(r.n_nodes),
-                       std::to_string(r.n_leaves), std::to_string(r.depth),
-                       mbr::cell(r.references_per_polygon, 2), mbr::cell_g(r.closest_per_s, 3),
-                       mbr::cell(r.closest_hit_fraction, 3), mbr::cell_g(r.shadow_per_s, 3),
-                       mbr::cell(r.shadow_hit_fraction, 3), ""});  // SOLVE HOOK: solve seconds
+        table.add_row({std::to_string(r.n_quads),
+                       std::to_string(r.n_surfaces),
+                       mbr::cell(r.megabytes, 2),
+                       mbr::cell_g(r.parse_s, 3),
+                       mbr::cell(1e6 * r.parse_s / quads, 2),
+                       mbr::cell_g(r.obj_parse_s, 3),
+                       mbr::cell_g(r.octree_s, 3),
+                       mbr::cell(1e6 * r.octree_s / quads, 2),
+                       std::to_string(r.n_polygons),
+                       std::to_string(r.n_nodes),
+                       std::to_string(r.n_leaves),
+                       std::to_string(r.depth),
+                       mbr::cell(r.references_per_polygon, 2),
+                       mbr::cell_g(r.closest_per_s, 3),
+                       mbr::cell(r.closest_hit_fraction, 3),
+                       mbr::cell_g(r.shadow_per_s, 3),
+                       mbr::cell(r.shadow_hit_fraction, 3),
+                       r.solved ? mbr::cell_g(r.solve_s, 3) : "",
+                       r.solved ? mbr::cell_g(r.shots_s, 3) : "",
+                       r.solved ? mbr::cell_g(r.solve_s - r.shots_s, 3) : "",
+                       r.solved ? std::to_string(r.transfers) : "",
+                       r.solved ? std::to_string(r.kernel_evals) : "",
+                       r.solved ? std::to_string(r.shadow_rays) : ""});
         if (!csv) std::cerr << "scene_scaling: " << n << " quads done\n";
     }
     if (csv) {
@@ -387,7 +484,11 @@ int run(mbr::Args& args) {
     std::cout << "Scenes of N quads: a room, a lamp and a grid of boxes; " << n_rays
               << " rays of each kind, seed " << seed << ", one thread.\n"
               << "parse_s: the scene of `quad` statements; obj_parse_s: the same boxes through "
-                 "`obj`; solve_s: not measured yet.\n\n";
+                 "`obj`; solve_s: "
+              << (solve.shots > 0 ? std::to_string(solve.shots) + " shots up to " +
+                                        std::to_string(solve.max_quads) + " quads"
+                                  : std::string("not measured (--solve-shots K)"))
+              << ".\n\n";
     table.write_text(std::cout);
     return 0;
 }

@@ -7,7 +7,8 @@
 //                         (--depth d | --adaptive [--oracle-tolerance T] [--min-depth a]
 //                         [--max-depth b]) [--order m] [--csv] ...
 //         Corners are given in (u,v) = (0,0), (1,0), (1,1), (0,1) order; each quad's front is
-//         the side (p10 - p00) x (p01 - p00) points to, and the two fronts must face each other.
+//         the side (p10 - p00) x (p01 - p00) points to, and the two fronts must face each other
+//         at least in part: some corner of each lies in front of the other's plane.
 // Expect: without --shooter/--receiver, the parallel unit squares at distance 1 of Table 1.
 #include <array>
 #include <iostream>
@@ -57,12 +58,11 @@ int run(mbr::Args& args) {
     const int grid = args.integer("--grid", 256, 2, 4096);
     const bool csv = args.flag("--csv");
     args.finish();
-    // The two fronts must face each other somewhere, or nothing is transferred.
-    const SurfacePoint centre = setup.receiver.evaluate(0.5, 0.5);
-    const SurfacePoint source = setup.shooter.evaluate(0.5, 0.5);
-    if (dot(source.position - centre.position, source.normal) >= 0 &&
-        dot(centre.position - source.position, centre.normal) >= 0)
-        throw UsageError("the shooter and the receiver do not face each other");
+    // The two fronts must face each other somewhere (tested at the corners: a receiver that
+    // straddles the shooter's plane gets energy on its part in front), or nothing is transferred.
+    if (!fronts_face_each_other(setup.shooter, setup.receiver))
+        throw UsageError("the shooter and the receiver do not face each other (no corner of one "
+                         "lies in front of the other)");
 
     const TransferRun run = run_transfer(setup, options, grid);
     if (run.errors.n_points == 0) throw UsageError("the receiver gets no energy from the shooter");

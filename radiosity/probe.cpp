@@ -5,9 +5,11 @@
 #include <algorithm>
 #include <array>
 #include <cctype>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <istream>
 #include <map>
@@ -332,8 +334,14 @@ std::vector<ProbePoint> parse_probe_points(std::istream& in, const std::string& 
 }
 
 std::vector<ProbePoint> read_probe_points(const std::string& path) {
+    errno = 0;
     std::ifstream in(path, std::ios::binary);
-    if (!in) throw InputError(path, 0, "cannot open the probe point file");
+    if (!in) {
+        const int err = errno;  // the system's reason, e.g. "Permission denied"
+        throw InputError(path, 0,
+                         std::string("cannot open the probe point file") +
+                             (err != 0 ? std::string(": ") + std::strerror(err) : std::string()));
+    }
     return parse_probe_points(in, path);
 }
 

@@ -5,8 +5,10 @@
 #include "radiosity/scene_io.h"
 
 #include <algorithm>
+#include <cerrno>
 #include <charconv>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <istream>
@@ -219,10 +221,20 @@ std::string resolve(const std::string& from, const std::string& file) {
     return (fs::path(from).parent_path() / p).string();
 }
 
+/// ": REASON" from errno after a failed open (": Permission denied"), or "" when the failure set
+/// none.
+std::string system_reason() {
+    const int err = errno;
+    return err != 0 ? std::string(": ") + std::strerror(err) : std::string();
+}
+
 /// Why `path` cannot be read as a regular file, or an empty string.
 std::string file_problem(const std::string& path) {
     std::error_code ec;
     fs::file_status st = fs::status(path, ec);
+    // Only a missing file is "not found"; anything else (a folder on the way that may not be
+    // searched, a file name used as a folder) gets the system's reason, e.g. "Permission denied".
+    if (ec && ec != std::errc::no_such_file_or_directory) return ec.message();
     if (ec || !fs::exists(st)) return "file not found";
     if (fs::is_directory(st)) return "is a folder, not a file";
     if (!fs::is_regular_file(st)) return "is not a regular file";
@@ -279,8 +291,9 @@ void open_named(const Line& line, const std::string& what, const std::string& pa
                 std::ifstream& in) {
     std::string problem = file_problem(path);
     if (!problem.empty()) line.fail(what + " " + in_quotes(path) + ": " + problem);
+    errno = 0;
     in.open(path, std::ios::binary);
-    if (!in) line.fail(what + " " + in_quotes(path) + ": cannot open it");
+    if (!in) line.fail(what + " " + in_quotes(path) + ": cannot open it" + system_reason());
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -1458,8 +1471,9 @@ private:
 void open_top(const std::string& path, std::ifstream& in) {
     std::string problem = file_problem(path);
     if (!problem.empty()) throw InputError(path, 0, problem);
+    errno = 0;
     in.open(path, std::ios::binary);
-    if (!in) throw InputError(path, 0, "cannot open the file");
+    if (!in) throw InputError(path, 0, "cannot open the file" + system_reason());
 }
 
 }  // namespace

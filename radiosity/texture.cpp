@@ -4,8 +4,10 @@
 #include <stb_image.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 
 #include "math/check.h"
 
@@ -102,7 +104,9 @@ Texture Texture::image(const std::string& path, Rgb scale) {
     int width = 0, height = 0, channels = 0;
     if (!stbi_info(path.c_str(), &width, &height, &channels)) {
         std::FILE* f = std::fopen(path.c_str(), "rb");
-        if (!f) throw InputError(path, 0, "cannot open the texture file");
+        if (!f)
+            throw InputError(path, 0,
+                             std::string("cannot open the texture file: ") + std::strerror(errno));
         std::fclose(f);
         const char* why = stbi_failure_reason();
         throw InputError(

@@ -243,6 +243,32 @@ TEST_CASE("cli: options a mode would ignore are refused", "[cli]") {
                Catch::StartsWith("--eps and --rhombus-radius exclude each other"));
 }
 
+TEST_CASE("cli: a transfer's quads face each other when any part does", "[cli]") {
+    // The shooter: the unit square in z = 0, its front +z ((p10 - p00) x (p01 - p00)).
+    const Surface shooter = Surface::planar_quad({0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0});
+    // Facing squarely: the unit square in z = 1, its front -z.
+    CHECK(fronts_face_each_other(
+        shooter, Surface::planar_quad({0, 0, 1}, {0, 1, 1}, {1, 1, 1}, {1, 0, 1})));
+    // The same square turned round faces away.
+    CHECK_FALSE(fronts_face_each_other(
+        shooter, Surface::planar_quad({0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1})));
+    // Coplanar, side by side: neither lies in front of the other.
+    CHECK_FALSE(fronts_face_each_other(
+        shooter, Surface::planar_quad({2, 0, 0}, {3, 0, 0}, {3, 1, 0}, {2, 1, 0})));
+    // Only in part: a quad in the plane x = 0.8, front +x, from z = -0.8 to 0.2. Its centre
+    // (z = -0.3) is behind the shooter and the shooter's centre (x = 0.5) behind it, so a test of
+    // the centres refused it; yet its strip z > 0 and the shooter's strip x > 0.8 face each other.
+    const Surface straddling =
+        Surface::planar_quad({0.8, 0, -0.8}, {0.8, 1, -0.8}, {0.8, 1, 0.2}, {0.8, 0, 0.2});
+    REQUIRE(straddling.evaluate(0.5, 0.5).normal.x > 0);
+    CHECK(fronts_face_each_other(shooter, straddling));
+    CHECK(fronts_face_each_other(straddling, shooter));
+    // Lowered to z in [-0.8, -0.1], all of it is behind the shooter: refused.
+    CHECK_FALSE(fronts_face_each_other(
+        shooter,
+        Surface::planar_quad({0.8, 0, -0.8}, {0.8, 1, -0.8}, {0.8, 1, -0.1}, {0.8, 0, -0.1})));
+}
+
 TEST_CASE("cli: a report that cannot be written to stdout gives status 1 and the reason", "[cli]") {
     if (::access("/dev/full", W_OK) != 0) {
         WARN("skipped: no /dev/full here");

@@ -4,6 +4,8 @@
 #include <unistd.h>
 
 #include <catch2/catch.hpp>
+#include <cerrno>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -372,6 +374,38 @@ TEST_CASE("scene_io: file not found", "[scene_io][errors]") {
                 "OBJ file '" + scenes_dir + "missing.obj': file not found");
     check_error(white + square + "include missing.scene\n", 3,
                 "included file '" + scenes_dir + "missing.scene': file not found");
+}
+
+TEST_CASE("scene_io: a file that cannot be read gives the system's reason", "[scene_io][errors]") {
+    // Only a missing file is "file not found": a file name used as a folder (ENOTDIR, which
+    // root meets too) and a file or folder without permission are reported as the system says.
+    TempDir dir;
+    const std::string plain = dir.write("plain", "not a folder\n");
+    const std::string not_dir = std::strerror(ENOTDIR);
+    InputError e =
+        error_of([](const std::string& p) { return load_scene(p); }, plain + "/x.scene");
+    CHECK(e.message() == not_dir);
+    const std::string top = dir.write("top.scene", white + square + "obj plain/x.obj\n");
+    e = error_of([](const std::string& p) { return load_scene(p); }, top);
+    CHECK(e.line() == 3);
+    CHECK(e.message() == "OBJ file '" + plain + "/x.obj': " + not_dir);
+
+    if (::geteuid() == 0) {
+        WARN("skipped the permission cases: root may read any file");
+        return;
+    }
+    const std::string locked = dir.write("locked.scene", white + square);
+    std::filesystem::permissions(locked, std::filesystem::perms::none);
+    e = error_of([](const std::string& p) { return load_scene(p); }, locked);
+    CHECK(e.message() == std::string("cannot open the file: ") + std::strerror(EACCES));
+    const std::filesystem::path closed = dir.path / "closed";
+    std::filesystem::create_directory(closed);
+    const std::string inside = (closed / "x.scene").string();
+    std::ofstream(inside) << white + square;
+    std::filesystem::permissions(closed, std::filesystem::perms::none);
+    e = error_of([](const std::string& p) { return load_scene(p); }, inside);
+    CHECK(e.message() == std::strerror(EACCES));
+    std::filesystem::permissions(closed, std::filesystem::perms::owner_all);  // let TempDir clean
 }
 
 TEST_CASE("scene_io: includes, their cycles and their depth", "[scene_io][errors]") {

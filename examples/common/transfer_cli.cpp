@@ -83,6 +83,18 @@ ReceiverOptions read_tree_options(Args& args, ReceiverOptions o) {
     return o;
 }
 
+bool fronts_face_each_other(const Surface& shooter, const Surface& receiver) {
+    // Relative to each plane's own centre, so that the test does not depend on where the pair
+    // sits; the normals are unit vectors, so a positive distance is a positive dot product.
+    auto some_corner_in_front = [](const Surface& quad, const Surface& plane) {
+        const SurfacePoint c = plane.evaluate(0.5, 0.5);
+        for (int k = 0; k < 4; ++k)
+            if (dot(quad.corners()[k] - c.position, c.normal) > 0) return true;
+        return false;
+    };
+    return some_corner_in_front(receiver, shooter) && some_corner_in_front(shooter, receiver);
+}
+
 std::string describe(const ReceiverOptions& o) {
     std::ostringstream os;
     const char* extrapolation = o.extrapolation == Extrapolation::Linear      ? "linear (23)-(25)"

@@ -27,6 +27,12 @@ ReceiverOptions read_receiver_options(Args& args);
 /// (radiosity/cost.h); a depth of slow_receiver_depth or more prints one warning on stderr.
 ReceiverOptions read_tree_options(Args& args, ReceiverOptions base);
 
+/// True when the fronts of two planar quads face each other somewhere: some corner of each lies
+/// strictly in front of the other's plane. Exact for convex quads (the signed distance to a plane
+/// is largest at a corner, and each plane is the same for all points of its quad), so a quad
+/// that faces the other only in part is accepted; testing the centres alone would refuse it.
+bool fronts_face_each_other(const Surface& shooter, const Surface& receiver);
+
 /// A one-line description of the options that matter for the tables.
 std::string describe(const ReceiverOptions& options);
 
