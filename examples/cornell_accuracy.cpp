@@ -65,7 +65,7 @@ struct Setting {
 const Setting ladder[] = {
     {"coarse", 1e-2, 3, 1e-2}, {"medium", 3e-3, 4, 3e-3},
     {"default", 0, 0, 0},  // the options as given (mbr render's defaults)
-    {"fine", 3e-4, 5, 3e-4},   {"finer", 1e-4, 6, 1e-4},
+    {"fine", 1e-3, 6, 1e-4},   {"finer", 3e-4, 7, 1e-4},
 };
 
 /// A reference point: where, and its radiosity.

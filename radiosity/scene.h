@@ -56,7 +56,7 @@ struct SolverSettings {
     int tessellation = 16;                 // facets per parameter direction for ray casting
     std::string shadows = "exact";         // "exact" (visibility inside (21)), "paper"
                                            //   (fractions (28) and masking) or "none"
-    double tolerance = 1e-3;               // accuracy relative to the scene's radiosity scale
+    double tolerance = 2e-3;               // accuracy relative to the scene's radiosity scale
     std::string unify = "projection";      // "projection" (every finest coefficient on the fine
                                            //   grid) or "paper" ((17) from selected fulcrums)
     bool ambient = true;                   // ambient correction of the unshot power at the end

@@ -35,7 +35,7 @@ struct SolverOptions {
     int max_shots = 100;            // stop after this many shots
     double convergence = 1e-3;      // stop when the largest unshot power < this x emitted
     bool self_transfer = false;     // concave curved surfaces receive from themselves
-    double tolerance = 1e-3;        // accuracy relative to the scene's radiosity scale: the
+    double tolerance = 2e-3;        // accuracy relative to the scene's radiosity scale: the
                                     //   absolute tolerance of every transfer (see file comment)
     double quadrature_share = 1;    // the quadrature's absolute tolerance, as a share of it
     int emission_level = 5;         // level at which a textured emission is projected

@@ -31,7 +31,7 @@ const char* solver_options_usage =
     "  --shots n                 at most n shots, 0..10000000 (scene's max_shots, default 100)\n"
     "  --convergence c           stop when the largest unshot power is below c x emitted, [0, 1)\n"
     "  --tolerance x             accuracy relative to the scene's radiosity scale, (0, 1)\n"
-    "                            (scene's `set tolerance`, default 1e-3): sets every\n"
+    "                            (scene's `set tolerance`, default 2e-3): sets every\n"
     "                            transfer's absolute tolerance\n"
     "  --shadows M               exact (visibility inside (21), default), paper\n"
     "                            (fractions (28) and masking) or none (`set shadows`)\n"
