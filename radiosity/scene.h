@@ -61,7 +61,7 @@ struct SolverSettings {
                                            //   grid) or "paper" ((17) from selected fulcrums)
     bool ambient = true;                   // ambient correction of the unshot power at the end
     bool hidden = true;                    // hidden regions take their visible neighbours' values
-    int shooter_level = 5;                 // a shooter's unshot field coarsened to at most this
+    int shooter_level = 3;                 // a shooter's unshot field coarsened to at most this
                                            //   level (section 6's "lower resolution version")
     int contact_depth = 2;                 // receiver cells touching a planar shooter split to
                                            //   at least this level (0: off)

@@ -43,12 +43,10 @@ struct SolverOptions {
                                     //   face take the nearest visible point's value
                                     //   (radiosity/hidden.h)
     HiddenOptions hidden;           // how hidden points are found
-    int shooter_level = 5;          // a shooter's unshot field is coarsened to at most this
+    int shooter_level = 3;          // a shooter's unshot field is coarsened to at most this
                                     //   level (the paper's "lower resolution version", section
                                     //   6); the receiver options' shooter_coarsening levels at
-                                    //   least. DESIGN: 5, not 3: at level 3 the floor's shadows
-                                    //   are smeared and the dark front of the Cornell box's
-                                    //   short block converges 4.9 % low (docs/method.md)
+                                    //   least (levels 4 and 5 measured: docs/method.md)
     bool ambient = true;            // beyond the paper: at the end, the power still unshot is
                                     //   sent on through the measured coupling of the surfaces
                                     //   (the fraction of each shooter's power each receiver got,

@@ -37,7 +37,7 @@ const char* solver_options_usage =
     "                            (fractions (28) and masking) or none (`set shadows`)\n"
     "  --rays R                  paper shadows: rays per shooter patch, 1..4096\n"
     "  --shooter-level L         a shooter's unshot field is coarsened to at most level L,\n"
-    "                            0..12 (scene's `set shooter_level`, default 5)\n"
+    "                            0..12 (scene's `set shooter_level`, default 3)\n"
     "  --contact-depth D         receiver cells touching a planar shooter split to at least\n"
     "                            level D, 0..12 (scene's `set contact_depth`, default 2)\n"
     "  --unify projection|paper  every finest coefficient projected on the fine grid\n"
