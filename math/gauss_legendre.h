@@ -66,7 +66,8 @@ struct AdaptiveOptions {
     // accumulated error, reached with far fewer cells where the error is spread thin (a spline
     // integrand whose knots every cell holds).
     bool global = false;
-    int max_cells = 20000;   // global strategy: stop refining beyond this many cells
+    int max_cells = 20000;   // global strategy: stop refining beyond this many cells (both
+                             //   strategies: no forced split beyond it)
 };
 
 /// A dyadic cell of the adaptive 2D rule: level, index (i, j) within the domain, its rectangle.
@@ -171,8 +172,11 @@ auto adaptive_tensor_rule_2d_global(CellRule& cell_rule, const Rect& domain, con
             result.n_evaluations += evals_per_cell;
             result.depth = std::max(result.depth, c.level);
             const double error = max_abs(f1 - f0);
-            // Cells above min_depth, and cells the caller does not trust, are split at once.
-            if (c.level < opt.max_depth && (c.level < opt.min_depth || force_split(c))) {
+            // Cells above min_depth, and cells the caller does not trust, are split at once; the
+            // forced splits stop at max_cells cells (a receiving point on a degenerate edge of
+            // the shooter, a sphere's pole, is next to every cell along that edge).
+            const bool room = long(heap.size() + done.size() + todo.size()) < long(opt.max_cells);
+            if (c.level < opt.max_depth && (c.level < opt.min_depth || (room && force_split(c)))) {
                 for (const QuadCell& ch : quad_children(c)) todo.push_back(ch);
                 continue;
             }
@@ -227,16 +231,19 @@ auto adaptive_tensor_rule_2d(CellRule&& cell_rule, const Rect& domain, const Ada
     struct Work { QuadCell cell; double tol; };
     std::vector<Work> stack{{QuadCell{0, 0, 0, domain}, opt.tolerance}};
     const long evals_per_cell = long(opt.n) * opt.n + long(opt.n + 1) * (opt.n + 1);
+    long n_cells = 0;
     while (!stack.empty()) {
         Work w = stack.back();
         stack.pop_back();
         V f0 = cell_rule(w.cell, opt.n);
         V f1 = cell_rule(w.cell, opt.n + 1);
         result.n_evaluations += evals_per_cell;
+        ++n_cells;
         if (w.cell.level > result.depth) result.depth = w.cell.level;
-        // A cell the caller does not trust (force_split) is split whatever the rules say.
+        // A cell the caller does not trust (force_split) is split whatever the rules say, until
+        // max_cells cells have been evaluated (see the global strategy).
         bool agree = max_abs(f1 - f0) <= w.tol && w.cell.level >= opt.min_depth &&
-                     !force_split(w.cell);
+                     !(n_cells < long(opt.max_cells) && force_split(w.cell));
         if (agree || w.cell.level >= opt.max_depth) {
             if (!agree) result.converged = false;
             result.value += f1;

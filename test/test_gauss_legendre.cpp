@@ -552,3 +552,25 @@ TEST_CASE("gauss: adaptive rules integrate Rgb-valued integrands channel by chan
     CHECK(r2.value.b == Approx(4.0).margin(1e-12));
     check_partition(r2, Rect{0, 2, -1, 1}, opt);
 }
+
+TEST_CASE("gauss_legendre: forced splits stop at max_cells in both strategies", "[gauss_legendre]") {
+    // A caller that distrusts every cell along an edge (a receiving point on a sphere's pole is
+    // next to all of them) would otherwise split 2^level cells at every level down to
+    // max_depth = 30. The area of the unit square must still come out, with the work bounded.
+    AdaptiveOptions opt;
+    opt.max_depth = 30;
+    opt.max_cells = 2000;
+    opt.tolerance = 1e-12;
+    auto area = [](const QuadCell& c, int) { return c.rect.width() * c.rect.height(); };
+    auto along_edge = [](const QuadCell& c) { return c.rect.y0 == 0; };
+    for (bool global : {false, true}) {
+        opt.global = global;
+        const auto r = adaptive_tensor_rule_2d(area, Rect{0, 1, 0, 1}, opt, true, along_edge);
+        CAPTURE(global);
+        // At most max_cells evaluated cells before forcing stops, plus the children that were
+        // already queued (at most four per evaluated cell of the last level).
+        const long per_cell = long(opt.n) * opt.n + long(opt.n + 1) * (opt.n + 1);
+        CHECK(r.n_evaluations / per_cell <= 5L * opt.max_cells);
+        CHECK(r.value == Approx(1.0).epsilon(1e-12));
+    }
+}
