@@ -39,9 +39,7 @@ int run(Args& args) {
     const Solution solution = solve_scene(run, !csv);
     if (per_shot && !csv) print_shots(std::cout, run.scene, solution.stats);
     if (csv) {
-        Table t({"shots", "unshot_percent", "seconds", "peak_mib", "coefficients"});
-        t.add_row(summary_cells(solution.stats));
-        t.write_csv(std::cout);
+        write_summary_csv(std::cout, solution.stats);
     } else {
         print_summary(std::cout, run, solution.stats);
     }

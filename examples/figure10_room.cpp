@@ -112,9 +112,7 @@ int run(Args& args) {
                       print_shot(std::cout, run.scene, shot, solver.solution().stats.emitted_power);
               });
     if (csv) {
-        Table t({"shots", "unshot_percent", "seconds", "peak_mib", "coefficients"});
-        t.add_row(summary_cells(solution.stats));
-        t.write_csv(std::cout);
+        write_summary_csv(std::cout, solution.stats);
     } else {
         print_summary(std::cout, run, solution.stats);
         print_time_by_shooter(std::cout, run.scene, solution.stats);

@@ -263,6 +263,12 @@ std::vector<std::string> summary_cells(const SolveStats& st) {
             std::to_string(st.coefficients)};
 }
 
+void write_summary_csv(std::ostream& os, const SolveStats& st) {
+    Table t({"shots", "unshot_percent", "seconds", "peak_mib", "coefficients"});
+    t.add_row(summary_cells(st));
+    t.write_csv(os);
+}
+
 void print_summary(std::ostream& os, const SceneRun& run, const SolveStats& st) {
     os << run.path << ": " << run.scene.surfaces.size() << " surfaces, "
        << run.octree->polygon_count() << " polygons\n"

@@ -48,6 +48,8 @@ void print_shots(std::ostream& os, const Scene& scene, const SolveStats& stats);
 void print_summary(std::ostream& os, const SceneRun& run, const SolveStats& stats);
 /// shots, unshot_percent, seconds, peak_mib, coefficients.
 std::vector<std::string> summary_cells(const SolveStats& stats);
+/// The run's summary as one CSV table: header shots,unshot_percent,seconds,peak_mib,coefficients.
+void write_summary_csv(std::ostream& os, const SolveStats& stats);
 
 /// Renders the solution with the scene's camera (radiance B / pi, sRGB tone mapping with
 /// options.exposure) and writes it as a PNG to `path` (all or nothing, radiosity/output_file.h).
