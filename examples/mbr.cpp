@@ -224,7 +224,8 @@ int main(int argc, char** argv) {
             return run_main(static_cast<int>(sub.size()), sub.data(), c.usage, c.body);
         }
     if (first.empty()) {
-        std::cerr << "mbr: a command is required: render, probe, reference or tables (mbr --help)\n";
+        std::cerr << "mbr: a command is required: render, probe, reference or tables "
+                     "(mbr --help)\n";
         return 2;
     }
     if (first == "--help" || first == "-h" || first == "help") {

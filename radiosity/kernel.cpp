@@ -508,8 +508,9 @@ IncrementIntegrator::Result IncrementIntegrator::integrate(const SurfacePoint& p
     opt.tolerance = std::max(options_.rel_tolerance * scale, options_.abs_tolerance);
     // Shadow subtraction (QuadratureOptions::shadow_subtraction): the cells below see only the
     // horizon; the part of the shooter the shadows hide (in front of p) is integrated here on
-    // its own (shadow_integral: the triangle with the largest error estimate splits first, until
-    // the estimates add up to half the tolerance), and subtracted. The rule over the cells gets the other half.
+    // its own (shadow_integral: the triangle with the largest error estimate splits first,
+    // until the estimates add up to half the tolerance), and subtracted. The rule over the
+    // cells gets the other half.
     Rgb shadowed;
     if (planar_ && options_.shadow_subtraction) take_shadows_apart();
     if (!shadow_regions_.empty()) {
