@@ -224,7 +224,7 @@ int main(int argc, char** argv) {
                        }});
 
     std::cout << "mbr_fuzz_readers: seed " << seed << ", scratch folder " << dir
-              << " (a crash leaves its input there), finds in " << finds << "\n";
+              << " (a crash leaves its input there), finds in " << finds << std::endl;
     int n_selected = 0;
     for (const Target& t : targets) n_selected += (only == "all" || only == t.name);
     if (n_selected == 0) {
@@ -266,7 +266,7 @@ int main(int argc, char** argv) {
                     finds / (t.name + "_" + std::to_string(i) + t.file.extension().string());
                 write_text(keep, text);
                 std::cout << "FIND " << t.name << " input " << i << ": " << find << " (saved to "
-                          << keep << ")\n";
+                          << keep << ")" << std::endl;
             }
         }
         const double seconds =
