@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-namespace mbr::fuzz {
+namespace mbr::fuzz_input {
 
 /// Tokens that matter to the scene, OBJ and MTL readers, inserted at random places.
 inline const char* const dictionary[] = {
@@ -144,4 +144,4 @@ inline std::string mutate(std::string text, std::mt19937_64& rng) {
     }
     return text;
 }
-}  // namespace mbr::fuzz
+}  // namespace mbr::fuzz_input

@@ -99,7 +99,7 @@ std::string replace_number(std::string text, std::mt19937_64& rng) {
 
 /// One input: the test's mutations, sometimes followed by extreme numbers.
 std::string make_input(const std::string& base, std::mt19937_64& rng) {
-    std::string text = rng() % 4 == 0 ? base : fuzz::mutate(base, rng);
+    std::string text = rng() % 4 == 0 ? base : fuzz_input::mutate(base, rng);
     for (int n = int(rng() % 3); n > 0; --n) text = replace_number(text, rng);
     return text;
 }

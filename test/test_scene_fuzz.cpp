@@ -61,7 +61,7 @@ const std::string obj_sample =
     "f 1 2 3 4\nf 1/1 2/2 3/1\nf 1//1 2//1 3//1 5//1 6//1\nf -6/-2/-1 -5/-1/-1 -4/-2/-1\n"
     "usemtl light\nf 1 2 5 4\nf 1 2 3 5 6\ng\nf 4 3 2 1\n";
 
-using fuzz::mutate;
+using fuzz_input::mutate;
 
 /// What the readers promise about every scene they return.
 void check_scene(const Scene& s) {
