@@ -7,6 +7,7 @@
 #include <ostream>
 #include <sstream>
 
+#include "math/bspline.h"
 #include "math/check.h"
 #include "radiosity/solver.h"
 
@@ -94,13 +95,24 @@ SplineField read_field(Reader& r, const char* what, int m) {
     r.expect(head, what, 3);
     if (head[1] != "level") r.fail(std::string("expected '") + what + " level J'");
     const int level = int(r.integer(head[2], 0, 14, "a level"));
+    // The count is checked against the first line before the field is made: a level-14 field of
+    // order 8 holds 3 x 2.7e8 coefficients (6 GiB), which a damaged 20-byte header must not
+    // allocate (found by test/fuzz_readers.cpp, issue 11).
+    const size_t n_coefficients = size_t(touching_count(m, level)) * touching_count(m, level);
+    std::vector<std::string> values = r.words("coefficients");
+    const auto check_count = [&] {
+        if (values.size() != n_coefficients)
+            r.fail("expected " + std::to_string(n_coefficients) + " coefficients, found " +
+                   std::to_string(values.size()));
+    };
+    check_count();
     SplineField f(m, level);
     for (int c = 0; c < 3; ++c) {
-        const std::vector<std::string> values = r.words("coefficients");
+        if (c > 0) {
+            values = r.words("coefficients");
+            check_count();
+        }
         std::vector<double>& a = f.channel(c).a;
-        if (values.size() != a.size())
-            r.fail("expected " + std::to_string(a.size()) + " coefficients, found " +
-                   std::to_string(values.size()));
         for (size_t i = 0; i < a.size(); ++i) a[i] = r.number(values[i]);
     }
     return f;

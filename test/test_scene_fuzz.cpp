@@ -17,6 +17,8 @@
 
 #include "math/check.h"
 #include "radiosity/scene_io.h"
+#include "radiosity/solver.h"
+#include "test/fuzz_mutate.h"
 
 using namespace mbr;
 
@@ -59,134 +61,7 @@ const std::string obj_sample =
     "f 1 2 3 4\nf 1/1 2/2 3/1\nf 1//1 2//1 3//1 5//1 6//1\nf -6/-2/-1 -5/-1/-1 -4/-2/-1\n"
     "usemtl light\nf 1 2 5 4\nf 1 2 3 5 6\ng\nf 4 3 2 1\n";
 
-const char* const dictionary[] = {"nan",
-                                  "inf",
-                                  "-inf",
-                                  "1e400",
-                                  "1e308",
-                                  "-1e308",
-                                  "1e-320",
-                                  "0",
-                                  "-0",
-                                  "-1",
-                                  "1",
-                                  "0.999",
-                                  "99999999999999999999",
-                                  "2147483648",
-                                  "#",
-                                  "\n",
-                                  " ",
-                                  "/",
-                                  "//",
-                                  "-",
-                                  ".",
-                                  "e",
-                                  "include",
-                                  "obj",
-                                  "quad",
-                                  "material",
-                                  "set",
-                                  "camera",
-                                  "inward",
-                                  "image",
-                                  "checker",
-                                  "f",
-                                  "v",
-                                  "usemtl",
-                                  "mtllib",
-                                  "newmtl",
-                                  "Kd",
-                                  "Ke",
-                                  "map_Kd",
-                                  "picture.png",
-                                  "nothere.png",
-                                  "\t",
-                                  "\r",
-                                  std::string("\0", 1).c_str(),
-                                  "\xff\xfe",
-                                  "\x89PNG",
-                                  "reflectance",
-                                  "emission",
-                                  "1e8",
-                                  "360",
-                                  "180",
-                                  "-360"};
-
-/// Returns a mutated copy of `text`: one to four random edits.
-std::string mutate(std::string text, std::mt19937_64& rng) {
-    auto pick = [&](size_t n) { return n == 0 ? size_t(0) : size_t(rng() % n); };
-    auto lines_of = [](const std::string& t) {
-        std::vector<std::string> lines;
-        std::string line;
-        std::istringstream in(t);
-        while (std::getline(in, line)) lines.push_back(line);
-        return lines;
-    };
-    auto join = [](const std::vector<std::string>& lines) {
-        std::string t;
-        for (const std::string& l : lines) t += l + "\n";
-        return t;
-    };
-    int n_edits = 1 + int(rng() % 4);
-    for (int e = 0; e < n_edits; ++e) {
-        switch (rng() % 9) {
-            case 0:  // flip bits of a byte
-                if (!text.empty()) text[pick(text.size())] ^= char(1 + rng() % 255);
-                break;
-            case 1: {  // insert random bytes
-                std::string bytes;
-                for (size_t n = 1 + pick(8); n > 0; --n) bytes += char(rng() % 256);
-                text.insert(pick(text.size() + 1), bytes);
-                break;
-            }
-            case 2:  // insert a token that matters to the readers
-                text.insert(pick(text.size() + 1),
-                            std::string(dictionary[pick(std::size(dictionary))]) + " ");
-                break;
-            case 3:  // delete a range
-                if (!text.empty()) text.erase(pick(text.size()), 1 + pick(16));
-                break;
-            case 4: {  // duplicate a line
-                auto lines = lines_of(text);
-                if (!lines.empty()) {
-                    size_t i = pick(lines.size());
-                    lines.insert(lines.begin() + long(pick(lines.size() + 1)), lines[i]);
-                }
-                text = join(lines);
-                break;
-            }
-            case 5: {  // swap two lines
-                auto lines = lines_of(text);
-                if (lines.size() >= 2)
-                    std::swap(lines[pick(lines.size())], lines[pick(lines.size())]);
-                text = join(lines);
-                break;
-            }
-            case 6:
-            case 7: {  // replace a number by a nasty one
-                std::vector<size_t> starts;
-                for (size_t i = 0; i < text.size(); ++i)
-                    if ((std::isdigit(static_cast<unsigned char>(text[i])) || text[i] == '-') &&
-                        (i == 0 || text[i - 1] == ' ' || text[i - 1] == '/'))
-                        starts.push_back(i);
-                if (starts.empty()) break;
-                size_t s = starts[pick(starts.size())], end = s;
-                while (end < text.size() && text[end] != ' ' && text[end] != '\n' &&
-                       text[end] != '/')
-                    ++end;
-                static const char* const nasty[] = {
-                    "nan",    "inf", "1e400", "1e300", "-1e300",      "-1",        "0",
-                    "1e-300", "1",   "7",     "-7",    "99999999999", "1.0000001", "0.99999999"};
-                text.replace(s, end - s, nasty[pick(std::size(nasty))]);
-                break;
-            }
-            case 8:  // truncate
-                text.resize(pick(text.size() + 1));
-                break;
-        }
-    }
-    return text;
-}
+using fuzz_input::mutate;
 
 /// What the readers promise about every scene they return.
 void check_scene(const Scene& s) {
@@ -319,4 +194,24 @@ TEST_CASE("scene_fuzz: mutated MTL files give a Scene or an InputError", "[scene
     CAPTURE(n_accepted, n_refused);
     CHECK(n_accepted > 50);
     CHECK(n_refused > 200);
+}
+
+TEST_CASE("scene_fuzz: a solution header naming a huge field is refused before allocating it",
+          "[scene_fuzz][solution]") {
+    // Found by mbr_fuzz_readers (issue 11; test/data/fuzz_finds/): 'radiosity level 14' at
+    // order 8 made load_solution allocate 3 x 2.7e8 coefficients (6 GiB) before it read the
+    // coefficient line that could never hold them. The reproducer is saved for
+    // examples/scenes/parallel_squares.scene, whose fingerprint it carries.
+    const Scene scene = load_scene(scenes_dir + "parallel_squares.scene");
+    const std::string path =
+        std::string(MBR_SOURCE_DIR) + "/test/data/fuzz_finds/solution_level14.solution";
+    std::ifstream in(path, std::ios::binary);
+    REQUIRE(in);
+    try {
+        load_solution(in, path, scene);
+        FAIL("the damaged solution loaded");
+    } catch (const InputError& e) {
+        CHECK(e.line() == 6);  // the first coefficient line
+        CHECK(std::string(e.message()).find("coefficients") != std::string::npos);
+    }
 }
