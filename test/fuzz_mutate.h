@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <fstream>
 #include <iterator>
 #include <random>
 #include <sstream>
@@ -144,4 +145,13 @@ inline std::string mutate(std::string text, std::mt19937_64& rng) {
     }
     return text;
 }
+
+/// The whole file, bytes as they are (a seed of the corpus).
+inline std::string read_whole_file(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    std::ostringstream os;
+    os << in.rdbuf();
+    return os.str();
+}
+
 }  // namespace mbr::fuzz_input

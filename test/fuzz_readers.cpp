@@ -39,12 +39,7 @@ namespace {
 
 const std::string scenes_dir = std::string(MBR_SOURCE_DIR) + "/examples/scenes/";
 
-std::string read_text(const fs::path& path) {
-    std::ifstream in(path, std::ios::binary);
-    std::ostringstream os;
-    os << in.rdbuf();
-    return os.str();
-}
+std::string read_text(const fs::path& path) { return fuzz_input::read_whole_file(path.string()); }
 
 void write_text(const fs::path& path, const std::string& text) {
     std::ofstream(path, std::ios::binary | std::ios::trunc) << text;
