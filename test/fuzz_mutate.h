@@ -146,6 +146,14 @@ inline std::string mutate(std::string text, std::mt19937_64& rng) {
     return text;
 }
 
+/// An OBJ with every face form, negative indices, groups and polygons to split.
+inline const std::string obj_sample =
+    "mtllib cornell_box.mtl\n"
+    "v 0 0 0\nv 2 0 0\nv 2 1 0\nv 0 1 0\nv 1 2 0.3\nv -1 1 0\nvt 0 0\nvt 1 1\nvn 0 0 1\n"
+    "o thing\ng part\nusemtl white\ns 1\n"
+    "f 1 2 3 4\nf 1/1 2/2 3/1\nf 1//1 2//1 3//1 5//1 6//1\nf -6/-2/-1 -5/-1/-1 -4/-2/-1\n"
+    "usemtl light\nf 1 2 5 4\nf 1 2 3 5 6\ng\nf 4 3 2 1\n";
+
 /// The whole file, bytes as they are (a seed of the corpus).
 inline std::string read_whole_file(const std::string& path) {
     std::ifstream in(path, std::ios::binary);
