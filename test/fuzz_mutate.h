@@ -6,7 +6,6 @@
 
 #include <algorithm>
 #include <cctype>
-#include <fstream>
 #include <iterator>
 #include <random>
 #include <sstream>
@@ -153,13 +152,5 @@ inline const std::string obj_sample =
     "o thing\ng part\nusemtl white\ns 1\n"
     "f 1 2 3 4\nf 1/1 2/2 3/1\nf 1//1 2//1 3//1 5//1 6//1\nf -6/-2/-1 -5/-1/-1 -4/-2/-1\n"
     "usemtl light\nf 1 2 5 4\nf 1 2 3 5 6\ng\nf 4 3 2 1\n";
-
-/// The whole file, bytes as they are (a seed of the corpus).
-inline std::string read_whole_file(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    std::ostringstream os;
-    os << in.rdbuf();
-    return os.str();
-}
 
 }  // namespace mbr::fuzz_input

@@ -30,6 +30,7 @@
 #include "radiosity/scene_io.h"
 #include "radiosity/scene_octree.h"
 #include "radiosity/solver.h"
+#include "test/file_bytes.h"
 #include "test/fuzz_mutate.h"
 
 namespace fs = std::filesystem;
@@ -39,7 +40,7 @@ namespace {
 
 const std::string scenes_dir = std::string(MBR_SOURCE_DIR) + "/examples/scenes/";
 
-std::string read_text(const fs::path& path) { return fuzz_input::read_whole_file(path.string()); }
+std::string read_text(const fs::path& path) { return test::read_bytes(path.string()); }
 
 void write_text(const fs::path& path, const std::string& text) {
     std::ofstream(path, std::ios::binary | std::ios::trunc) << text;

@@ -33,6 +33,7 @@
 #include <vector>
 
 #include "math/vec3.h"
+#include "test/file_bytes.h"
 #include "test/report.h"
 
 #ifndef MBR_TOOL
@@ -113,12 +114,7 @@ void write_text(const std::string& path, const std::string& text) {
     REQUIRE(out.good());
 }
 
-std::string read_bytes(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    std::ostringstream os;
-    os << in.rdbuf();
-    return os.str();
-}
+using mbr::test::read_bytes;
 
 // Every file and folder below `folder`, as paths relative to it: a run may leave nothing else.
 std::set<std::string> entries_under(const fs::path& folder) {

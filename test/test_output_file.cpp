@@ -26,6 +26,7 @@
 
 #include "radiosity/image.h"
 #include "radiosity/output_file.h"
+#include "test/file_bytes.h"
 
 using namespace mbr;
 namespace fs = std::filesystem;
@@ -70,12 +71,7 @@ private:
     std::vector<std::string> mounts_;
 };
 
-std::string read_all(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    std::ostringstream os;
-    os << in.rdbuf();
-    return os.str();
-}
+using test::read_bytes;
 
 // The names in a folder: after a failed write, no temporary may be among them.
 std::set<std::string> names_in(const std::string& folder) {
@@ -117,15 +113,15 @@ TEST_CASE("output_file: a new file holds exactly the bytes; a regular file is re
     const std::string path = dir / "a.bin";
     const std::string first = pattern_bytes(100000), second = pattern_bytes(777);
     write_file(path, first);
-    CHECK(read_all(path) == first);
+    CHECK(read_bytes(path) == first);
     // The replaced file keeps its permissions (mkstemp alone would make it 0600).
     REQUIRE(::chmod(path.c_str(), 0640) == 0);
     write_file(path, second);
-    CHECK(read_all(path) == second);  // shorter: nothing of the old content is left behind
+    CHECK(read_bytes(path) == second);  // shorter: nothing of the old content is left behind
     CHECK((mode_of(path) & 07777) == 0640);
     // The stream form gives the same bytes.
     write_file(path, [&](std::ostream& os) { os << first; });
-    CHECK(read_all(path) == first);
+    CHECK(read_bytes(path) == first);
     CHECK(names_in(dir.path().string()) == std::set<std::string>{"a.bin"});
 }
 
@@ -139,7 +135,7 @@ TEST_CASE("output_file: a writer that throws touches no file", "[output_file]") 
                                    throw std::runtime_error("the producer failed");
                                }),
                     std::runtime_error);
-    CHECK(read_all(path) == "old\n");
+    CHECK(read_bytes(path) == "old\n");
     CHECK(names_in(dir.path().string()) == std::set<std::string>{"table.csv"});
 }
 
@@ -152,7 +148,7 @@ TEST_CASE("output_file: a symbolic link stays a link and its target is replaced"
     write_file(link, std::string("new content"));
     CHECK(S_ISLNK(mode_of(link)));
     CHECK(fs::read_symlink(link) == "sub/target.png");
-    CHECK(read_all(target) == "new content");
+    CHECK(read_bytes(target) == "new content");
 
     // A chain of two links ends at the same file.
     const std::string link2 = dir / "link2.png";
@@ -160,14 +156,14 @@ TEST_CASE("output_file: a symbolic link stays a link and its target is replaced"
     write_file(link2, std::string("third"));
     CHECK(S_ISLNK(mode_of(link2)));
     CHECK(S_ISLNK(mode_of(link)));
-    CHECK(read_all(target) == "third");
+    CHECK(read_bytes(target) == "third");
 
     // A dangling link: its target is created, the link is kept.
     const std::string dangling = dir / "dangling.png";
     fs::create_symlink("sub/created.png", dangling);
     write_file(dangling, std::string("created"));
     CHECK(S_ISLNK(mode_of(dangling)));
-    CHECK(read_all(dir / "sub/created.png") == "created");
+    CHECK(read_bytes(dir / "sub/created.png") == "created");
 
     // A dangling link into a missing folder is refused, naming the folder.
     const std::string nowhere = dir / "nowhere.png";
@@ -241,7 +237,7 @@ TEST_CASE("output_file: stdout is written through its descriptor, whatever it is
     struct stat after;
     REQUIRE(::stat(file.c_str(), &after) == 0);
     CHECK(after.st_ino == before.st_ino);
-    CHECK(read_all(file) == bytes);
+    CHECK(read_bytes(file) == bytes);
     CHECK(names_in(dir.path().string()) == std::set<std::string>{"captured.png"});
 
     // Stdout on a pipe.
@@ -348,7 +344,7 @@ TEST_CASE("output_file: a read-only folder refuses the write and keeps the old f
     CHECK(message == target + ": cannot write in folder '" + folder + "': " + reason);
     CHECK(output_error([&] { check_output_path(folder + "/new.png"); }) ==
           folder + "/new.png: cannot write in folder '" + folder + "': " + reason);
-    CHECK(read_all(target) == "old");
+    CHECK(read_bytes(target) == "old");
     CHECK(names_in(folder) == std::set<std::string>{"old.png"});
 }
 
@@ -367,7 +363,7 @@ TEST_CASE("output_file: a full disk gives an error, no temporary file and the ol
     // Twice the size of the disk: the temporary fills it up.
     std::string message = output_error([&] { write_file(target, pattern_bytes(128 * 1024)); });
     CHECK(message == target + ": cannot write: " + full_reason);
-    CHECK(read_all(target) == old);
+    CHECK(read_bytes(target) == old);
     CHECK(names_in(folder) == std::set<std::string>{"ex.png"});
 
     // A PNG that does not fit, through write_png: an OutputError, not a cut-off image.
@@ -387,6 +383,6 @@ TEST_CASE("output_file: a full disk gives an error, no temporary file and the ol
             {{target, pattern_bytes(40 * 1024)}, {folder + "/b.png", pattern_bytes(40 * 1024)}});
     });
     CHECK(message == folder + "/b.png: cannot write: " + full_reason);
-    CHECK(read_all(target) == old);
+    CHECK(read_bytes(target) == old);
     CHECK(names_in(folder) == std::set<std::string>{"ex.png"});
 }

@@ -18,6 +18,7 @@
 #include "math/check.h"
 #include "radiosity/scene_io.h"
 #include "radiosity/solver.h"
+#include "test/file_bytes.h"
 #include "test/fuzz_mutate.h"
 
 using namespace mbr;
@@ -26,7 +27,7 @@ namespace {
 
 const std::string scenes_dir = std::string(MBR_SOURCE_DIR) + "/examples/scenes/";
 
-using fuzz_input::read_whole_file;
+using test::read_bytes;
 
 /// A scene that uses every statement, so mutations reach every branch of the reader.
 const std::string every_statement =
@@ -121,7 +122,7 @@ TEST_CASE("scene_fuzz: mutated scene files give a Scene or an InputError", "[sce
     std::vector<std::string> seeds = {every_statement};
     for (const char* f : {"parallel_squares.scene", "perpendicular_squares.scene",
                           "three_strips.scene", "room.scene", "cornell_box.scene"})
-        seeds.push_back(read_whole_file(scenes_dir + f));
+        seeds.push_back(read_bytes(scenes_dir + f));
     for (const std::string& s : seeds) REQUIRE(!s.empty());
     int n_accepted = 0, n_refused = 0;
     const uint64_t seed = 20240601;
@@ -139,7 +140,7 @@ TEST_CASE("scene_fuzz: mutated scene files give a Scene or an InputError", "[sce
 }
 
 TEST_CASE("scene_fuzz: mutated OBJ files give a Scene or an InputError", "[scene_fuzz][obj]") {
-    std::vector<std::string> seeds = {obj_sample, read_whole_file(scenes_dir + "cornell_box.obj")};
+    std::vector<std::string> seeds = {obj_sample, read_bytes(scenes_dir + "cornell_box.obj")};
     int n_accepted = 0, n_refused = 0;
     fuzz(
         seeds, 3000, 77,
@@ -161,7 +162,7 @@ TEST_CASE("scene_fuzz: mutated MTL files give a Scene or an InputError", "[scene
     std::filesystem::create_directories(dir);
     std::filesystem::copy_file(scenes_dir + "picture.png", dir / "picture.png",
                                std::filesystem::copy_options::overwrite_existing);
-    const std::string mtl_seed = read_whole_file(scenes_dir + "cornell_box.mtl") +
+    const std::string mtl_seed = read_bytes(scenes_dir + "cornell_box.mtl") +
                                  "newmtl tex\nKa 0.1 0.1 0.1\nKd 0.5 0.5 0.5\nmap_Kd -s 1 1 1 "
                                  "picture.png\nKe 0.1 0.1 0.1\nmap_Ke picture.png\nNs 10\nd 1\n"
                                  "illum 2\n";
