@@ -64,6 +64,17 @@ gallery() {
     cp "$tmp"/*square*.png "$dir/"
     build/examples/figure10_room -o "$dir/figure10_room.png"
     ls -l "$dir"
+    # The tutorial (docs/tutorial/): every chapter program at its defaults, its images and its
+    # printed output beside the pages that embed them.
+    local program name
+    mkdir -p docs/tutorial/images docs/tutorial/output
+    for program in build/examples/tutorial_*; do
+        [ -x "$program" ] || continue
+        name=$(basename "$program")
+        echo "== $name =="
+        "$program" -o docs/tutorial/images >"$tmp/$name.txt"
+        mv "$tmp/$name.txt" "docs/tutorial/output/$name.txt"
+    done
 }
 
 case "${1:-}" in

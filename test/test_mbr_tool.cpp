@@ -7,20 +7,16 @@
 // no progress bar appears with --quiet or without a terminal.
 //
 // The tool's path comes from the compile definition MBR_TOOL (test/CMakeLists.txt). It is run
-// with posix_spawn, no shell, so that the temporary folders' names can hold spaces (they do).
+// by test/run_program.h, no shell, so that the temporary folders' names can hold spaces (they do).
 // The scene is tiny (three rectangles, max_depth 3, at most 3 shots, a 32 x 24 camera, one sample
 // per pixel), so that every run of the tool takes a fraction of a second, also under ASan.
 #include <fcntl.h>
-#include <signal.h>
-#include <spawn.h>
 #include <stb_image.h>
-#include <sys/wait.h>
 #include <termios.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <catch2/catch.hpp>
-#include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -29,18 +25,16 @@
 #include <set>
 #include <sstream>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include "math/vec3.h"
 #include "test/file_bytes.h"
 #include "test/report.h"
+#include "test/run_program.h"
 
 #ifndef MBR_TOOL
 #error "MBR_TOOL must name the mbr program (test/CMakeLists.txt defines it)"
 #endif
-
-extern char** environ;
 
 namespace fs = std::filesystem;
 using Catch::Matchers::Contains;
@@ -75,38 +69,8 @@ constexpr double light_area = 0.3 * 0.6, total_area = 1 + light_area + 1;
 // The bounding box [0, 2] x [0, 1] x [0, 1] and its diagonal.
 const double scene_diagonal = std::sqrt(4.0 + 1 + 1);
 
-// What a run of the tool did: its exit status (-signal when a signal ended it), stdout, stderr.
-struct ToolRun {
-    int status = -1;
-    std::string out, err;
-};
-
-std::ostream& operator<<(std::ostream& os, const ToolRun& r) {
-    return os << "status " << r.status << "\nstdout:\n" << r.out << "stderr:\n" << r.err;
-}
-
-// A fresh folder under the system's temporary folder, with a space in its name, removed at the
-// end with everything in it.
-class TempFolder {
-public:
-    TempFolder() {
-        std::string pattern = (fs::temp_directory_path() / "mbr_tool test XXXXXX").string();
-        REQUIRE(::mkdtemp(pattern.data()) != nullptr);
-        path_ = pattern;
-    }
-    ~TempFolder() {
-        std::error_code ec;
-        fs::remove_all(path_, ec);
-    }
-    TempFolder(const TempFolder&) = delete;
-    TempFolder& operator=(const TempFolder&) = delete;
-
-    std::string operator/(const std::string& name) const { return (path_ / name).string(); }
-    const fs::path& path() const { return path_; }
-
-private:
-    fs::path path_;
-};
+using mbr::test::TempFolder;
+using ToolRun = mbr::test::ProgramRun;
 
 void write_text(const std::string& path, const std::string& text) {
     std::ofstream out(path, std::ios::binary);
@@ -124,70 +88,9 @@ std::set<std::string> entries_under(const fs::path& folder) {
     return names;
 }
 
-// An anonymous file for one captured stream (unlinked at once; the descriptor keeps it).
-int capture_file() {
-    std::string name = (fs::temp_directory_path() / "mbr_tool capture XXXXXX").string();
-    const int fd = ::mkstemp(name.data());
-    REQUIRE(fd >= 0);
-    ::unlink(name.c_str());
-    return fd;
-}
-
-std::string read_fd(int fd) {
-    std::string s;
-    ::lseek(fd, 0, SEEK_SET);
-    char buffer[4096];
-    for (ssize_t n; (n = ::read(fd, buffer, sizeof buffer)) > 0;) s.append(buffer, size_t(n));
-    return s;
-}
-
-// Runs `mbr ARGS...` with stdin from /dev/null, stdout and stderr captured into anonymous files,
-// or stderr on `stderr_fd` when that is given (its content is then the caller's to read). The
-// environment is inherited. A run that has not ended after five minutes is killed: a hang then
-// fails the test instead of stopping the suite (a guard, not a measurement).
+// Runs `mbr ARGS...` (test/run_program.h), stderr on `stderr_fd` when that is given.
 ToolRun run_mbr(const std::vector<std::string>& args, int stderr_fd = -1) {
-    const int out_fd = capture_file();
-    const int err_fd = stderr_fd >= 0 ? stderr_fd : capture_file();
-    std::vector<std::string> words = {MBR_TOOL};
-    words.insert(words.end(), args.begin(), args.end());
-    std::vector<char*> argv;
-    for (std::string& w : words) argv.push_back(w.data());
-    argv.push_back(nullptr);
-
-    posix_spawn_file_actions_t actions;
-    REQUIRE(posix_spawn_file_actions_init(&actions) == 0);
-    posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
-    posix_spawn_file_actions_adddup2(&actions, out_fd, 1);
-    posix_spawn_file_actions_adddup2(&actions, err_fd, 2);
-    posix_spawn_file_actions_addclose(&actions, out_fd);
-    if (err_fd != 2) posix_spawn_file_actions_addclose(&actions, err_fd);
-    pid_t pid = -1;
-    const int spawned = posix_spawn(&pid, MBR_TOOL, &actions, nullptr, argv.data(), environ);
-    posix_spawn_file_actions_destroy(&actions);
-    INFO("posix_spawn of " << MBR_TOOL);
-    REQUIRE(spawned == 0);
-
-    int wait_status = 0;
-    const auto give_up = std::chrono::steady_clock::now() + std::chrono::minutes(5);
-    pid_t done = 0;
-    while ((done = ::waitpid(pid, &wait_status, WNOHANG)) == 0 &&
-           std::chrono::steady_clock::now() < give_up)
-        std::this_thread::sleep_for(std::chrono::milliseconds(1));
-    if (done == 0) {
-        ::kill(pid, SIGKILL);
-        ::waitpid(pid, &wait_status, 0);
-    }
-    ToolRun run;
-    run.out = read_fd(out_fd);
-    ::close(out_fd);
-    if (stderr_fd < 0) {
-        run.err = read_fd(err_fd);
-        ::close(err_fd);
-    }
-    INFO("mbr did not end within five minutes");
-    REQUIRE(done == pid);
-    run.status = WIFEXITED(wait_status) ? WEXITSTATUS(wait_status) : -WTERMSIG(wait_status);
-    return run;
+    return mbr::test::run_program(MBR_TOOL, args, stderr_fd);
 }
 
 size_t count_lines(const std::string& s) {

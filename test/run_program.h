@@ -1,0 +1,155 @@
+// test/run_program.h - tests that run a program of the project as a child process: the mbr tool
+// (test_mbr_tool.cpp) and the tutorial's chapter programs (test_tutorial_*.cpp). The program is
+// started with posix_spawn, no shell, so that paths may hold spaces; its stdout and stderr are
+// captured, and a run that has not ended after five minutes is killed, so that a hang fails the
+// test instead of stopping the suite (a guard, not a measurement).
+//
+// MBR_EXAMPLES_DIR (test/CMakeLists.txt) names the folder of the built example programs.
+#pragma once
+
+#include <fcntl.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <catch2/catch.hpp>
+#include <chrono>
+#include <cstdlib>
+#include <filesystem>
+#include <ostream>
+#include <string>
+#include <thread>
+#include <vector>
+
+extern char** environ;
+
+namespace mbr::test {
+
+/// What a run of a program did: its exit status (-signal when a signal ended it), stdout, stderr.
+struct ProgramRun {
+    int status = -1;
+    std::string out, err;
+};
+
+inline std::ostream& operator<<(std::ostream& os, const ProgramRun& r) {
+    return os << "status " << r.status << "\nstdout:\n" << r.out << "stderr:\n" << r.err;
+}
+
+/// A fresh folder under the system's temporary folder, with a space in its name, removed at the
+/// end with everything in it.
+class TempFolder {
+public:
+    TempFolder() {
+        std::string pattern =
+            (std::filesystem::temp_directory_path() / "mbr test XXXXXX").string();
+        REQUIRE(::mkdtemp(pattern.data()) != nullptr);
+        path_ = pattern;
+    }
+    ~TempFolder() {
+        std::error_code ec;
+        std::filesystem::remove_all(path_, ec);
+    }
+    TempFolder(const TempFolder&) = delete;
+    TempFolder& operator=(const TempFolder&) = delete;
+
+    std::string operator/(const std::string& name) const { return (path_ / name).string(); }
+    const std::filesystem::path& path() const { return path_; }
+
+private:
+    std::filesystem::path path_;
+};
+
+/// An anonymous file for one captured stream (unlinked at once; the descriptor keeps it).
+inline int capture_file() {
+    std::string name =
+        (std::filesystem::temp_directory_path() / "mbr capture XXXXXX").string();
+    const int fd = ::mkstemp(name.data());
+    REQUIRE(fd >= 0);
+    ::unlink(name.c_str());
+    return fd;
+}
+
+/// Everything written to the descriptor, from its start.
+inline std::string read_fd(int fd) {
+    std::string s;
+    ::lseek(fd, 0, SEEK_SET);
+    char buffer[4096];
+    for (ssize_t n; (n = ::read(fd, buffer, sizeof buffer)) > 0;) s.append(buffer, size_t(n));
+    return s;
+}
+
+/// Runs `program ARGS...` with stdin from /dev/null and stdout and stderr captured, or stderr on
+/// `stderr_fd` when that is given (its content is then the caller's to read). The environment is
+/// inherited.
+inline ProgramRun run_program(const std::string& program, const std::vector<std::string>& args,
+                              int stderr_fd = -1) {
+    const int out_fd = capture_file();
+    const int err_fd = stderr_fd >= 0 ? stderr_fd : capture_file();
+    std::vector<std::string> words = {program};
+    words.insert(words.end(), args.begin(), args.end());
+    std::vector<char*> argv;
+    for (std::string& w : words) argv.push_back(w.data());
+    argv.push_back(nullptr);
+
+    posix_spawn_file_actions_t actions;
+    REQUIRE(posix_spawn_file_actions_init(&actions) == 0);
+    posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
+    posix_spawn_file_actions_adddup2(&actions, out_fd, 1);
+    posix_spawn_file_actions_adddup2(&actions, err_fd, 2);
+    posix_spawn_file_actions_addclose(&actions, out_fd);
+    if (err_fd != 2) posix_spawn_file_actions_addclose(&actions, err_fd);
+    pid_t pid = -1;
+    const int spawned =
+        posix_spawn(&pid, program.c_str(), &actions, nullptr, argv.data(), environ);
+    posix_spawn_file_actions_destroy(&actions);
+    INFO("posix_spawn of " << program);
+    REQUIRE(spawned == 0);
+
+    int wait_status = 0;
+    const auto give_up = std::chrono::steady_clock::now() + std::chrono::minutes(5);
+    pid_t done = 0;
+    while ((done = ::waitpid(pid, &wait_status, WNOHANG)) == 0 &&
+           std::chrono::steady_clock::now() < give_up)
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    if (done == 0) {
+        ::kill(pid, SIGKILL);
+        ::waitpid(pid, &wait_status, 0);
+    }
+    ProgramRun run;
+    run.out = read_fd(out_fd);
+    ::close(out_fd);
+    if (stderr_fd < 0) {
+        run.err = read_fd(err_fd);
+        ::close(err_fd);
+    }
+    INFO(program << " did not end within five minutes");
+    REQUIRE(done == pid);
+    run.status = WIFEXITED(wait_status) ? WEXITSTATUS(wait_status) : -WTERMSIG(wait_status);
+    return run;
+}
+
+#ifdef MBR_EXAMPLES_DIR
+/// Runs the example program `name` (built into MBR_EXAMPLES_DIR) with ARGS.
+inline ProgramRun run_example(const std::string& name, const std::vector<std::string>& args) {
+    return run_program(std::string(MBR_EXAMPLES_DIR) + "/" + name, args);
+}
+#endif
+
+/// The number printed right after the first occurrence of `label` in `text` (spaces, '=' and
+/// ':' between them are skipped), so that a test can read a program's report as a student reads
+/// it. Fails the test when the label is missing or no number follows it.
+inline double number_after(const std::string& text, const std::string& label) {
+    const size_t at = text.find(label);
+    INFO("looking for \"" << label << "\" in:\n" << text);
+    REQUIRE(at != std::string::npos);
+    size_t i = at + label.size();
+    while (i < text.size() && (text[i] == ' ' || text[i] == '=' || text[i] == ':')) ++i;
+    const char* begin = text.c_str() + i;
+    char* end = nullptr;
+    const double value = std::strtod(begin, &end);
+    REQUIRE(end != begin);
+    return value;
+}
+
+}  // namespace mbr::test
