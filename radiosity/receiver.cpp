@@ -250,9 +250,12 @@ void subdivide_by_oracle(ReceiverState& state, IncrementSampler& sampler) {
     if (opt.weak_receiver > 0 && opt.absolute_tolerance > 0 && scale < opt.weak_receiver * opt.absolute_tolerance)
         min_depth = 0;
 
-    // The shooter's plane when it is planar (the contact rule of ReceiverOptions::contact_depth).
+    // The shooter's plane when it is planar (the contact rule of ReceiverOptions::contact_depth
+    // and contact_oracle_test).
+    const bool contact_rule =
+        opt.contact_depth > 0 || opt.contact_oracle_test != opt.oracle_test;
     const ShooterPlane* contact_plane =
-        opt.contact_depth > 0 ? sampler.integrator(0).shooter_plane() : nullptr;
+        contact_rule ? sampler.integrator(0).shooter_plane() : nullptr;
 
     enum Action { Leaf, Split, SplitOnceMore };
     std::vector<int> frontier{forest.domain_root()};
@@ -266,14 +269,19 @@ void subdivide_by_oracle(ReceiverState& state, IncrementSampler& sampler) {
                 action[c] = Split;
                 return;
             }
-            if (cell.level < opt.contact_depth && contact_plane &&
-                touches_shooter(*sampler.receiver().surface, *contact_plane, cell.rect())) {
+            const bool contact = contact_plane && touches_shooter(*sampler.receiver().surface,
+                                                                   *contact_plane, cell.rect());
+            if (cell.level < opt.contact_depth && contact) {
                 action[c] = Split;
                 return;
             }
             if (cell.level >= opt.max_depth) return;  // a leaf
             const int th = thread_index();
-            if (opt.oracle_test == OracleTest::Interpolation) {
+            // DESIGN: a cell touching the shooter takes contact_oracle_test (Interpolation in
+            // scenes): there dB grows like d log d, whose two means agree long before the
+            // spline can follow it.
+            const OracleTest test = contact ? opt.contact_oracle_test : opt.oracle_test;
+            if (test == OracleTest::Interpolation) {
                 action[c] = interpolation_agrees(cell.rect(), th, &evals[c], &increments[c], scale)
                                 ? SplitOnceMore
                                 : Split;

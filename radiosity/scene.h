@@ -65,6 +65,11 @@ struct SolverSettings {
                                            //   level (section 6's "lower resolution version")
     int contact_depth = 2;                 // receiver cells touching a planar shooter split to
                                            //   at least this level (0: off)
+    std::string contact_oracle = "means";  // the oracle's test in cells touching a planar
+                                           //   shooter: "means" (the paper's test) or
+                                           //   "interpolation" (the polynomial through the m^2
+                                           //   samples predicts the others: sees the d log d
+                                           //   growth at a contact, costs more)
 };
 
 /// A whole scene. Surface i's material is materials[surfaces[i].material].

@@ -1380,6 +1380,11 @@ private:
             s.shooter_level = integer(0, 12);
         } else if (key == "contact_depth") {
             s.contact_depth = integer(0, 12);
+        } else if (key == "contact_oracle") {
+            if (value != "interpolation" && value != "means")
+                line.fail("contact_oracle " + in_quotes(value) +
+                          " is neither 'interpolation' nor 'means'");
+            s.contact_oracle = value;
         } else if (key == "ambient" || key == "hidden") {
             if (value != "true" && value != "false")
                 line.fail(key + " " + in_quotes(value) + " is neither 'true' nor 'false'");
@@ -1389,7 +1394,7 @@ private:
                       " (known: order, min_depth, max_depth, oracle_tolerance, truncation_eps, "
                       "rhombus_radius, extrapolation, shadow_rays, max_shots, convergence, "
                       "self_transfer, tessellation, shadows, tolerance, unify, ambient, hidden, "
-                      "shooter_level, contact_depth)");
+                      "shooter_level, contact_depth, contact_oracle)");
         }
     }
 

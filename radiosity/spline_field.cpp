@@ -54,11 +54,26 @@ Rgb SplineField::evaluate(double s, double t) const {
 
 void SplineField::evaluate_grid(const double* s, int n_s, const double* t, int n_t,
                                 Rgb* out) const {
-    MBR_CHECK(n_t >= 1 && n_t <= 64);
+    MBR_CHECK(n_t >= 1 && n_s >= 0);
     const CoefficientGrid& g0 = grid_[0];
-    double bs[16], bt[64][16];
-    int fl[64];
-    for (int b = 0; b < n_t; ++b) fl[b] = bspline_values(m_, std::ldexp(t[b], level_), bt[b]);
+    double bs[16];
+    // The m B-spline values at every t: on the stack for the quadrature's small grids, on the
+    // heap for large ones (a 1024-column grid of an error check).
+    constexpr int n_small = 64;
+    double bt_small[n_small * 16];
+    int fl_small[n_small];
+    std::vector<double> bt_large;
+    std::vector<int> fl_large;
+    double* bt = bt_small;
+    int* fl = fl_small;
+    if (n_t > n_small) {
+        bt_large.resize(size_t(n_t) * 16);
+        fl_large.resize(size_t(n_t));
+        bt = bt_large.data();
+        fl = fl_large.data();
+    }
+    for (int b = 0; b < n_t; ++b)
+        fl[b] = bspline_values(m_, std::ldexp(t[b], level_), &bt[size_t(b) * 16]);
     // The l needed by any t: one row of that many sums per s (any level: no fixed bound).
     int l_lo = fl[0], l_hi = fl[0];
     for (int b = 1; b < n_t; ++b) {
@@ -87,7 +102,8 @@ void SplineField::evaluate_grid(const double* s, int n_s, const double* t, int n
         }
         for (int b = 0; b < n_t; ++b) {
             Rgb v;
-            for (int j = 0; j < m_; ++j) v += bt[b][j] * row[fl[b] + j - l_lo];
+            const double* w = &bt[size_t(b) * 16];
+            for (int j = 0; j < m_; ++j) v += w[j] * row[fl[b] + j - l_lo];
             out[a * n_t + b] = v;
         }
     }

@@ -12,6 +12,7 @@
 
 #include "math/check.h"
 #include "radiosity/scene_io.h"
+#include "radiosity/solver.h"
 
 using namespace mbr;
 using Catch::Matchers::Contains;
@@ -463,6 +464,8 @@ TEST_CASE("scene_io: settings and camera are checked", "[scene_io][errors]") {
     check_error(white + square + "set truncation_eps 0\n", 3, "truncation_eps 0 is outside (0, 1)");
     check_error(white + square + "set extrapolation cubic\n", 3, "neither 'linear' nor 'higher'");
     check_error(white + square + "set self_transfer yes\n", 3, "neither 'true' nor 'false'");
+    check_error(white + square + "set contact_oracle mean\n", 3,
+                "contact_oracle 'mean' is neither 'interpolation' nor 'means'");
     check_error(white + square + "set min_depth 5\nset max_depth 3\n", 4,
                 "min_depth 5 exceeds max_depth 3");
     check_error(white + square + "camera eye 0 0 1 look_at 0 0 1\n", 3, "eye and look_at coincide");
@@ -499,7 +502,7 @@ TEST_CASE("scene_io: every statement of the format", "[scene_io]") {
         "set order 3\nset min_depth 2\nset max_depth 5\nset oracle_tolerance 1e-4\n"
         "set truncation_eps 1e-7\nset rhombus_radius 20\nset extrapolation higher\n"
         "set shadow_rays 8\nset max_shots 10\nset convergence 0.01\nset self_transfer true\n"
-        "set tessellation 8\n");
+        "set tessellation 8\nset contact_oracle interpolation\n");
     CHECK(s.materials.size() == 4 + 4);
     CHECK(s.surfaces.size() == 3 + 12 + 6 + 16);
     CHECK(s.emitters().size() == 12 + 2 + 1);  // the img boxes, the lamp spheres, the OBJ light
@@ -527,9 +530,13 @@ TEST_CASE("scene_io: every statement of the format", "[scene_io]") {
     CHECK(o.convergence == 0.01);
     CHECK(o.self_transfer);
     CHECK(o.tessellation == 8);
+    CHECK(o.contact_oracle == "interpolation");
+    CHECK(solver_options(o).receiver.contact_oracle_test == OracleTest::Interpolation);
     // Defaults when nothing is set.
     Scene d = parse_text(white + square);
     CHECK(d.settings.order == 4);
+    CHECK(d.settings.contact_oracle == "means");
+    CHECK(solver_options(d.settings).receiver.contact_oracle_test == OracleTest::Means);
     CHECK(d.settings.extrapolation == "linear");
     CHECK(!d.has_camera);
 }

@@ -40,6 +40,9 @@ const char* solver_options_usage =
     "                            0..12 (scene's `set shooter_level`, default 3)\n"
     "  --contact-depth D         receiver cells touching a planar shooter split to at least\n"
     "                            level D, 0..12 (scene's `set contact_depth`, default 2)\n"
+    "  --contact-oracle T        the oracle's test in cells touching a planar shooter:\n"
+    "                            means (the paper's, default) or interpolation\n"
+    "                            (`set contact_oracle`)\n"
     "  --unify projection|paper  every finest coefficient projected on the fine grid\n"
     "                            (default), or the paper's (17) from selected fulcrums\n"
     "                            (`set unify`)\n"
@@ -60,10 +63,11 @@ struct SolverArgs {
         contact_depth = -1;
     double convergence = -1, tolerance = -1;
     double memory_budget = 0;
-    std::string shadows, unify, ambient, hidden;
+    std::string shadows, unify, ambient, hidden, contact_oracle;
     // Which options the command line gave: only those override the scene's `set` lines.
     bool has_min_depth = false, has_max_depth = false, has_tolerance = false,
-         has_shadows = false, has_unify = false, has_ambient = false, has_hidden = false;
+         has_shadows = false, has_unify = false, has_ambient = false, has_hidden = false,
+         has_contact_oracle = false;
 };
 
 SolverArgs read_solver_args(Args& args, SceneRun& run) {
@@ -89,6 +93,7 @@ SolverArgs read_solver_args(Args& args, SceneRun& run) {
     a.shooter_level = args.integer("--shooter-level", -1);
     a.contact_depth = args.integer("--contact-depth", -1);
     a.unify = args.text("--unify", "projection");
+    a.contact_oracle = args.text("--contact-oracle", "means");
     a.ambient = args.text("--ambient", "on");
     a.hidden = args.text("--hidden", "on");
     run.threads = args.integer("--threads", 0);
@@ -101,6 +106,7 @@ SolverArgs read_solver_args(Args& args, SceneRun& run) {
     a.has_unify = args.has("--unify");
     a.has_ambient = args.has("--ambient");
     a.has_hidden = args.has("--hidden");
+    a.has_contact_oracle = args.has("--contact-oracle");
 
     if (args.has("--order")) in_range("--order", a.order, 2, 8);
     if (a.has_min_depth) in_range("--min-depth", a.min_depth, 0, 12);
@@ -116,6 +122,8 @@ SolverArgs read_solver_args(Args& args, SceneRun& run) {
         throw UsageError("--shadows must be exact, paper or none");
     if (a.unify != "projection" && a.unify != "paper")
         throw UsageError("--unify must be projection or paper");
+    if (a.contact_oracle != "interpolation" && a.contact_oracle != "means")
+        throw UsageError("--contact-oracle must be interpolation or means");
     for (const auto& [name, value] :
          {std::pair{"--ambient", a.ambient}, std::pair{"--hidden", a.hidden}})
         if (value != "on" && value != "off")
@@ -149,6 +157,9 @@ void finish_scene_run(const SolverArgs& a, SceneRun& run) {
     if (a.rays > 0) o.receiver.shadows.rays_per_patch = a.rays;
     if (a.shooter_level >= 0) o.shooter_level = a.shooter_level;
     if (a.contact_depth >= 0) o.receiver.contact_depth = a.contact_depth;
+    if (a.has_contact_oracle)
+        o.receiver.contact_oracle_test = a.contact_oracle == "means" ? OracleTest::Means
+                                                                     : OracleTest::Interpolation;
     if (a.has_ambient) o.ambient = a.ambient == "on";
     if (a.has_unify) o.receiver.unify_by_projection = a.unify == "projection";
     if (a.has_hidden) o.hidden_regions = a.hidden == "on";
