@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
+#include <limits>
 #include <set>
 
 #include "math/bspline.h"
@@ -62,16 +63,26 @@ std::vector<double> cholesky_solve(std::vector<double> G, std::vector<double> b,
 
 /// The points of one planar surface's hull on the far side of the other's plane (or all on its
 /// plane): nothing can pass between them. Curved surfaces are never ruled out here.
-bool behind(const Surface& planar, const Surface& other) {
-    if (planar.kind() != Surface::Kind::PlanarQuad && planar.kind() != Surface::Kind::Disk)
-        return false;
+bool is_planar(const Surface& s) {
+    return s.kind() == Surface::Kind::PlanarQuad || s.kind() == Surface::Kind::Disk;
+}
+
+/// How far the other surface's hull reaches in front of the planar one's plane (its largest
+/// signed distance), and the plane tolerance of behind() below.
+double front_reach(const Surface& planar, const Surface& other, double* tolerance) {
     const Vec3 n = planar.normal(0.5, 0.5);
     const Vec3 o = planar.point(0.5, 0.5);
     const Box3 b = planar.bounds();
-    const double tol = 1e-9 * std::max(length(b.extent()), length(o));
-    for (const Vec3& q : hull_points(other))
-        if (dot(n, q - o) > tol) return false;
-    return true;
+    *tolerance = 1e-9 * std::max(length(b.extent()), length(o));
+    double reach = -std::numeric_limits<double>::infinity();
+    for (const Vec3& q : hull_points(other)) reach = std::max(reach, dot(n, q - o));
+    return reach;
+}
+
+bool behind(const Surface& planar, const Surface& other) {
+    if (!is_planar(planar)) return false;
+    double tolerance = 0;
+    return front_reach(planar, other, &tolerance) <= tolerance;
 }
 
 std::uint64_t cell_key(const DyadicCell& c) {
@@ -80,6 +91,29 @@ std::uint64_t cell_key(const DyadicCell& c) {
 }
 
 }  // namespace
+
+std::vector<NearContact> near_contacts(const Scene& scene) {
+    std::vector<NearContact> found;
+    const int n = static_cast<int>(scene.surfaces.size());
+    for (int e : scene.emitters())
+        for (int i = 0; i < n; ++i) {
+            if (i == e) continue;
+            for (const auto& [a, b] : {std::pair{e, i}, std::pair{i, e}}) {
+                const Surface& planar = scene.surfaces[size_t(a)].surface;
+                if (!is_planar(planar)) continue;
+                double tolerance = 0;
+                const double reach =
+                    front_reach(planar, scene.surfaces[size_t(b)].surface, &tolerance);
+                // Above rounding (1e-4 of the tolerance, 1e-13 of the size) and within the
+                // tolerance: apart, but treated as lying on the plane.
+                if (reach > 1e-4 * tolerance && reach <= tolerance) {
+                    found.push_back({a, b, reach});
+                    break;  // one report per pair
+                }
+            }
+        }
+    return found;
+}
 
 SolverOptions solver_options(const SolverSettings& s) {
     SolverOptions o;

@@ -58,6 +58,17 @@ struct SolverOptions {
 /// The scene's `set` statements as solver options (shadows: the scene's method and rays).
 SolverOptions solver_options(const SolverSettings& settings);
 
+/// A surface b that lies in front of planar surface a's plane, but by no more than the plane
+/// tolerance of the receiver test (1e-9 of a's size): the solver treats it as lying on that
+/// plane, so no light passes between a and b (a light 1e-9 below a ceiling or above a floor).
+struct NearContact {
+    int a = -1, b = -1;  // surface indices
+    double gap = 0;      // how far b reaches in front of a's plane
+};
+/// The near contacts between each emitter and every other surface (O(emitters x surfaces)),
+/// found before solving so that programs can warn about them.
+std::vector<NearContact> near_contacts(const Scene& scene);
+
 /// One shot of the loop, measured.
 struct ShotStats {
     int shot = 0;              // 1, 2, ...

@@ -439,3 +439,25 @@ TEST_CASE("solver: a surface solved at depth 8 shoots", "[solver]") {
                        << first.seconds << " and " << shot.seconds << " s\n";
     }
 }
+
+TEST_CASE("solver: near_contacts names a light a hair above the floor, not a resting block",
+          "[solver]") {
+    // A light 1e-9 above a unit floor is inside the receiver test's plane tolerance (1e-9 of
+    // the floor's size): it is taken as lying on the floor, and the programs warn. At 1e-6 the
+    // floor receives, so nothing is reported; a block standing on the floor touches it exactly
+    // (rounding only) and is not reported either.
+    auto scene_with_gap = [](const std::string& gap) {
+        return scene_from("material light reflectance 0 0 0 emission 1 1 1\n"
+                          "material grey reflectance 0.5 0.5 0.5\n"
+                          "rectangle floor grey 0 0 0  0 0 1  1 0 0\n"
+                          "rectangle light light 0.3 " + gap + " 0.3  0.4 0 0  0 0 0.4\n"
+                          "box block light 0.6 0 0.6  0.9 0.2 0.9\n");  // glows: checked
+    };
+    const Scene hair = scene_with_gap("1e-9");
+    const std::vector<NearContact> near = near_contacts(hair);
+    REQUIRE(near.size() == 1);
+    CHECK(hair.surfaces[size_t(near[0].a)].name == "floor");
+    CHECK(hair.surfaces[size_t(near[0].b)].name == "light");
+    CHECK(near[0].gap == Approx(1e-9).epsilon(1e-6));
+    CHECK(near_contacts(scene_with_gap("1e-6")).empty());
+}

@@ -173,6 +173,19 @@ void finish_scene_run(const SolverArgs& a, SceneRun& run) {
                    " surfaces, max depth " + std::to_string(d) + ", tessellation " +
                    std::to_string(run.scene.settings.tessellation) + ")",
                d >= slow_receiver_depth);
+    // A light a hair's breadth from a surface is taken as lying on it: say so, once.
+    const std::vector<NearContact> near = near_contacts(run.scene);
+    if (!near.empty()) {
+        const NearContact& c = near.front();
+        std::ostringstream os;
+        os << "warning: " << run.path << ": '" << run.scene.surfaces[size_t(c.b)].name
+           << "' lies " << c.gap << " in front of the plane of '"
+           << run.scene.surfaces[size_t(c.a)].name
+           << "', within the solver's plane tolerance: it is taken as lying on it, and no light "
+              "passes between them";
+        if (near.size() > 1) os << " (and " << near.size() - 1 << " more such pairs)";
+        std::cerr << os.str() << "\n";
+    }
     run.octree = std::make_unique<Octree>(build_octree(run.scene));
 }
 
