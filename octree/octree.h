@@ -124,10 +124,16 @@ public:
     template <class NodeTest>
     std::vector<int> polygons_near(NodeTest&& node_may_meet) const {
         std::vector<int> out;
-        if (root_) collect(*root_, root_cube_, node_may_meet, out);
+        append_polygons_near(node_may_meet, out);
         std::sort(out.begin(), out.end());
         out.erase(std::unique(out.begin(), out.end()), out.end());
         return out;
+    }
+    /// The same polygons appended to `out` in the order of the walk, a polygon listed by several
+    /// accepted leaves once for each (for callers that filter first and sort what is left).
+    template <class NodeTest>
+    void append_polygons_near(NodeTest&& node_may_meet, std::vector<int>& out) const {
+        if (root_) collect(*root_, root_cube_, node_may_meet, out);
     }
 
     /// The polygons, in the order given to the constructor (Hit::polygon indexes them).

@@ -169,7 +169,7 @@ bool segment_blocked(const OcclusionContext& context, const std::vector<int>& oc
                      Vec3 b, long* n_rays) {
     if (occluders.empty()) return false;
     // DESIGN: up to 32 occluders are tested one by one; beyond, the octree is faster.
-    if (occluders.size() > 32) return segment_blocked(context, a, b, n_rays);
+    if (occluders.size() > max_listed_occluders) return segment_blocked(context, a, b, n_rays);
     if (n_rays) ++*n_rays;
     const Ray ray{a, b - a, 1e-9, 1 - 1e-9};
     const std::vector<Polygon>& polys = context.octree->polygons();
@@ -237,7 +237,7 @@ std::optional<Plane> surface_plane(const Surface& surface) {
 }
 
 std::vector<int> occluders_toward(const OcclusionContext& context, const ShooterPlane& plane,
-                                  Vec3 p) {
+                                  Vec3 p, size_t limit) {
     // The pyramid: a plane through p and each edge of the shooter's outline, and the shooter's
     // own plane (nothing beyond the shooter blocks a segment that ends on it).
     struct Side {
@@ -285,11 +285,38 @@ std::vector<int> occluders_toward(const OcclusionContext& context, const Shooter
             if (!outside_polygon(id)) out.push_back(id);
         return out;
     }
-    for (int id : context.octree->polygons_near([&](const Box3& b) { return !outside_box(b); }))
+    // The octree's leaves one at a time (a polygon listed by several leaves comes several
+    // times): each listed candidate that meets the pyramid is kept, and the kept ones are made
+    // unique whenever they outgrow twice the limit; more than `limit` distinct ones stop the
+    // walk (the node test then refuses every further node).
+    bool enough = false;
+    auto compact = [&out] {
+        std::sort(out.begin(), out.end());
+        out.erase(std::unique(out.begin(), out.end()), out.end());
+    };
+    std::vector<int> listed;
+    context.octree->append_polygons_near(
+        [&](const Box3& b) {
+            if (enough) return false;
+            for (int id : listed)
+                if (std::binary_search(context.candidates.begin(), context.candidates.end(),
+                                       id) &&
+                    !outside_polygon(id))
+                    out.push_back(id);
+            listed.clear();
+            if (limit != SIZE_MAX && out.size() > 2 * limit) {
+                compact();
+                enough = out.size() > limit;
+                if (enough) return false;
+            }
+            return !outside_box(b);
+        },
+        listed);
+    for (int id : listed)
         if (std::binary_search(context.candidates.begin(), context.candidates.end(), id) &&
             !outside_polygon(id))
             out.push_back(id);
-    std::sort(out.begin(), out.end());
+    compact();
     return out;
 }
 

@@ -72,6 +72,10 @@ OcclusionContext make_occlusion_context(const Octree& octree, const Surface& sho
                                         int shooter_surface, const Surface& receiver,
                                         int receiver_surface, std::uint64_t shot);
 
+/// Up to this many occluders a segment is tested against the list one by one; beyond, the
+/// octree is faster (segment_blocked with a list, occluders_toward's limit).
+constexpr size_t max_listed_occluders = 32;
+
 /// True when an occluder of the context blocks the open segment a -> b (any-hit: a loop over
 /// the candidates when they are few, else the octree with the pair's own surfaces skipped; the
 /// answer is the same). Counts the ray in *n_rays.
@@ -133,8 +137,11 @@ struct BlockedView {
 /// The context's candidates that meet the pyramid from p to a planar shooter (the convex hull
 /// of p and the shooter's outline), increasing: the only polygons that can block a segment
 /// from p to a point of the shooter. The octree finds them when the candidates are many.
+/// With a `limit`, the search stops as soon as more than `limit` distinct occluders are found
+/// and returns those (more than `limit`, not all): enough for a caller that tests rays against
+/// the list when it is short and against the octree otherwise.
 std::vector<int> occluders_toward(const OcclusionContext& context, const ShooterPlane& plane,
-                                  Vec3 p);
+                                  Vec3 p, size_t limit = SIZE_MAX);
 
 /// The view from point p (normal n_p). `context` may be null (horizon only). When p lies on a
 /// planar receiver, `receiver_plane` (may be null) gives its plane: the horizon is then the

@@ -62,7 +62,9 @@ Rgb compute_fraction(const ReceiverState& state, IncrementSampler& sampler, Vec2
     std::vector<int> toward;
     const ShooterPlane* plane = integrator.shooter_plane();
     if (plane) {
-        toward = occluders_toward(ctx, *plane, p.position);
+        // More than max_listed_occluders: the rays go through the octree, so the list need
+        // not be complete (the pyramid from a ceiling point to the floor holds the whole room).
+        toward = occluders_toward(ctx, *plane, p.position, max_listed_occluders);
         if (toward.empty()) return {1, 1, 1};
     }
     const IncrementIntegrator::Result r =
