@@ -177,8 +177,8 @@ int run(Args& args) {
                            cell_g(e.max, 3), first ? "" : cell(std::log2(previous.max / e.max), 2),
                            cell_g(e.rms, 3),
                            first ? "" : cell(std::log2(previous.rms / e.rms), 2)});
-            std::cout << functions[q].name << " level " << j << ": max error = " << cell_g(e.max, 4)
-                      << ", rms error = " << cell_g(e.rms, 4) << "\n";
+            std::cout << functions[q].name << " level " << j << ": max error = " << cell_g(e.max, 6)
+                      << ", rms error = " << cell_g(e.rms, 6) << "\n";
             previous = e;
         }
     }
@@ -201,7 +201,7 @@ int run(Args& args) {
         sweep.add_row({cell(r, 0), cell_g(dn.eps_for_rhombus_radius(r), 2), std::to_string(cells),
                        std::to_string(cells * m * m), cell_g(e.max, 3), cell_g(e.rms, 3)});
         std::cout << "r = " << r << ": cells per coefficient = " << cells
-                  << ", max error = " << cell_g(e.max, 4) << "\n";
+                  << ", max error = " << cell_g(e.max, 6) << "\n";
         rs.push_back(r), max_errors.push_back(e.max), rms_errors.push_back(e.rms);
         costs.push_back(double(cells));
     }
