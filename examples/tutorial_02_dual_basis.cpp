@@ -109,13 +109,14 @@ int run(Args& args) {
     // M_{m;N}, M_{m;N+1}, ... (rows -K..K) until the central rows of two successive inverses
     // agree within eps for |l| <= N (math/dual_basis.h: dual_coefficients).
     std::cout << "Part 2. The appendix: growing sections M_{3;K} until mu_l settles (N = 18)\n";
-    for (double e : {1e-4, 1e-8, eps}) {
+    for (double e : {1e-4, 1e-8, 1e-12}) {
         const DualCoefficients dc = dual_coefficients(m, 18, e);
         std::cout << "eps " << cell_g(e, 2) << ": matrices inverted = " << dc.n_matrices
                   << ", last half-width K = " << dc.final_half_width
                   << ", last change = " << cell_g(dc.last_change, 2) << "\n";
     }
     const DualCoefficients dc = dual_coefficients(m, 18, eps);
+    std::cout << "Table 3 by the appendix with eps = " << cell_g(eps, 2) << ":\n";
     Table table({"l", "mu_{3;0,l}", "paper (Table 3)", "difference", "mu_l / mu_{l-1}"});
     int n_match = 0;
     for (int l = 0; l <= 18; ++l) {

@@ -163,6 +163,7 @@ int run(Args& args) {
     // === Part 1. The error against the scale. Halving the knot spacing 2^-j should divide the
     // error by 2^rate: rate m for a smooth f (the spline matches its Taylor polynomial of degree
     // m - 1 on each cell), less where f has a kink or a step.
+    std::cout << "Part 1. The error against the scale 2^-j (r = " << cell(radius, 4) << " cells)\n";
     const std::vector<TestFunction> functions = test_functions();
     std::vector<std::vector<SplineField>> fields(functions.size());
     Table table({"function", "level j", "coefficients", "max error", "rate", "rms error", "rate"});
