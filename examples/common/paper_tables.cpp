@@ -72,14 +72,13 @@ int run_paper_table(Args& args, const PaperRow* rows, int n_rows, bool parallel)
     return 0;
 }
 
-namespace {
-// Table 3 of the paper, mu_{3;0,l} for l = 0..18.
-const double paper_mu3[] = {2.842171,  -1.321729, 0.573326,  -0.247042, 0.106378,
-                                -0.045804, 0.019722,  -0.008492, 0.003656,  -0.001574,
-                                0.000678,  -0.000292, 0.000126,  -0.000054, 0.000023,
-                                -0.000010, 0.000004,  -0.000002, 0.000001};
-constexpr int n_l = 19;
+const double paper_table3[19] = {2.842171,  -1.321729, 0.573326,  -0.247042, 0.106378,
+                                 -0.045804, 0.019722,  -0.008492, 0.003656,  -0.001574,
+                                 0.000678,  -0.000292, 0.000126,  -0.000054, 0.000023,
+                                 -0.000010, 0.000004,  -0.000002, 0.000001};
 
+namespace {
+constexpr int n_l = 19;
 }  // namespace
 
 int run_table3(Args& args) {
@@ -93,7 +92,7 @@ int run_table3(Args& args) {
     for (int m : {3, 2, 4}) {
         const DualCoefficients dc = dual_coefficients(m, n_l - 1, eps);
         for (int l = 0; l < n_l; ++l) {
-            const double paper = m == 3 ? paper_mu3[l] : NAN;
+            const double paper = m == 3 ? paper_table3[l] : NAN;
             if (m == 3 && std::fabs(dc.mu[l] - paper) < 0.5e-6) ++n_match;
             table.add_row({std::to_string(m), std::to_string(l), cell(dc.mu[l], csv ? 12 : 6),
                            std::isnan(paper) ? "" : cell(paper, 6)});
