@@ -211,7 +211,7 @@ int run(Args& args) {
                        std::to_string(leaves_after), std::to_string(stats.n_fractions),
                        std::to_string(stats.n_shadow_splits), std::to_string(stats.n_rays),
                        cell(100 * e.rea, 3), cell(100 * e.l1, 3)});
-        std::cout << "depth " << depth << ": rea = " << cell(100 * e.rea, 4)
+        std::cout << "shadow depth " << depth << ": rea = " << cell(100 * e.rea, 4)
                   << " %, rays = " << stats.n_rays << "\n";
         x_depth.push_back(depth);
         y_rea.push_back(100 * e.rea);
@@ -231,16 +231,22 @@ int run(Args& args) {
     std::cout << "\nfractions (28) at depth " << d_last << " along t = 0.5 (rays "
               << options.shadows.rays_per_patch << " per patch):\n";
     Table fractions({"s", "fraction_28", "exact_fraction", "difference"});
-    double worst = 0;
+    double worst = 0, centre_28 = 0, centre_exact = 0;
     for (double s : {0.0, 0.1, 0.2, 0.3, 0.4, 0.5}) {
         const double f28 = fraction_at(last_state, sampler, s, 0.5, /*thread=*/0).r;
         const Vec3 p{s, 0.5, 0}, up{0, 0, 1};
         const double visible = shadowed_form_factor(p, up, shooter_polygon, occluder) /
                                point_polygon_form_factor(p, up, shooter_polygon);
         worst = std::max(worst, std::fabs(f28 - visible));
+        if (s == 0.5) {
+            centre_28 = f28;
+            centre_exact = visible;
+        }
         fractions.add_row({cell(s, 1), cell(f28, 4), cell(visible, 4), cell(f28 - visible, 4)});
     }
     fractions.write_text(std::cout);
+    std::cout << "fraction (28) at the centre: " << cell(centre_28, 4) << "\n"
+              << "exact fraction at the centre: " << cell(centre_exact, 4) << "\n";
     std::cout << "largest fraction error along the line: " << cell(worst, 4) << "\n";
 
     // For contrast, visibility inside (21) itself (ShadowMethod::Exact, beyond the paper): the

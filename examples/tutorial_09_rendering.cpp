@@ -47,7 +47,8 @@ const char* usage =
     "  --max-depth d       receiver quadtree depth, 1..8 (default 6, the scene's)\n"
     "  --tolerance x       accuracy relative to the radiosity scale, (0, 1) (default 2e-3)\n"
     "  --shots n           at most n shots, 1..1000 (default 100)\n"
-    "  --spp n             camera samples per pixel, 1..64 (default 4)\n";
+    "  --spp n             camera samples per pixel, 1..64 (default 4)\n"
+    "  --size n            the render's width and height, 16..2048 (default 512, the scene's)\n";
 
 /// The reference file: --points when given, else the shared data folder beside the repository,
 /// else the repository's own copy (the one cornell_accuracy reads). InputError (exit status 2)
@@ -180,6 +181,7 @@ int run(Args& args) {
     const int shots = args.integer("--shots", 100, 1, 1000);
     RenderOptions render;
     render.samples_per_pixel = args.integer("--spp", render.samples_per_pixel, 1, 64);
+    const int size = args.integer("--size", 512, 16, 2048);
     args.finish();
     if (!(tolerance > 0 && tolerance < 1)) throw UsageError("--tolerance must be in (0, 1)");
     // The reference is checked before the solve, so a missing file costs no time.
@@ -193,6 +195,7 @@ int run(Args& args) {
     options.receiver.min_depth = std::min(options.receiver.min_depth, max_depth);
     options.tolerance = tolerance;
     options.max_shots = shots;
+    scene.camera.width = scene.camera.height = size;
     const Octree octree = build_octree(scene);
     const Solution solution = solve(scene, octree, options);
     std::cout << "tutorial_09_rendering: Cornell box, max depth " << max_depth << ", tolerance "
