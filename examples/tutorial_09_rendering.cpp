@@ -220,7 +220,8 @@ int run(Args& args) {
     const std::map<std::string, Reference> ref = read_reference_values(points_path);
     const std::vector<SurfaceLocation> at =
         locate_probe_points(scene, octree.polygons(), points, points_path, probe_tolerance(scene));
-    std::cout << "\nreference: " << points_path << "\n"
+    std::cout << "\nreference: " << std::filesystem::path(points_path).filename().string() << ", "
+              << points.size() << " points\n"
               << "luminance Y = 0.2126 R + 0.7152 G + 0.0722 B; error = Y_mbr / Y_ref - 1\n\n";
     Table table({"point", "surface", "shadow", "B_ref (r g b)", "B_mbr (r g b)", "Y_ref", "Y_mbr",
                  "error_%"});
