@@ -12,7 +12,7 @@
 //      where the receiver needs small cells, and draws its tree over dB.
 // Run: tutorial_04_sample_values [-o DIR] [--h H] [--min-depth a] [--max-depth b]
 //                                [--oracle-tolerance T]
-// Writes DIR/04_quadrature.png and DIR/04_oracle_tree.png.
+// Writes DIR/tutorial_04_quadrature.png and DIR/tutorial_04_oracle_tree.png.
 #include <cmath>
 #include <filesystem>
 #include <iostream>
@@ -194,7 +194,7 @@ int run(Args& args) {
     }
     Image quadrature(900, 620, {1, 1, 1});
     plot.draw(quadrature, {0, 0, 900, 620});
-    write_png((std::filesystem::path(dir) / "04_quadrature.png").string(), quadrature);
+    write_png((std::filesystem::path(dir) / "tutorial_04_quadrature.png").string(), quadrature);
 
     // 3. The oracle (section 6): on each cell compare the means of dB by ceil(m/2)^2 and m^2
     // points; where they agree the cell is split once more and stopped. The samples come from
@@ -231,8 +231,8 @@ int run(Args& args) {
                                  "Oracle tree, h = " + cell_g(h, 3) + ", tolerance " +
                                      cell_g(options.oracle_tolerance, 3) + ": " +
                                      std::to_string(n_leaves) + " leaves over dB");
-    write_png((std::filesystem::path(dir) / "04_oracle_tree.png").string(), tree);
-    std::cout << "\nwrote " << dir << "/04_quadrature.png and " << dir << "/04_oracle_tree.png\n";
+    write_png((std::filesystem::path(dir) / "tutorial_04_oracle_tree.png").string(), tree);
+    std::cout << "\nwrote " << dir << "/tutorial_04_quadrature.png and " << dir << "/tutorial_04_oracle_tree.png\n";
     return 0;
 }
 

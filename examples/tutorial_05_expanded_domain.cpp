@@ -13,7 +13,7 @@
 //      cubic (27), and the exact form factor continued, and measures the error (29) near the
 //      boundary and inside.
 // Run: tutorial_05_expanded_domain [-o DIR] [--h H] [--depth d] [--eps E]
-// Writes DIR/05_expanded_domain.png and DIR/05_extrapolation_profiles.png.
+// Writes DIR/tutorial_05_expanded_domain.png and DIR/tutorial_05_extrapolation_profiles.png.
 #include <cmath>
 #include <filesystem>
 #include <iostream>
@@ -248,7 +248,7 @@ int run(Args& args) {
                       {0, 0, 0}, 2);
     draw_colour_scale(ring, {margin + side / 2, side + margin + 90, side, 20}, v_lo, v_hi,
                       "dB (exact inside, extrapolated outside)", diverging_map, 2);
-    write_png((std::filesystem::path(dir) / "05_expanded_domain.png").string(), ring);
+    write_png((std::filesystem::path(dir) / "tutorial_05_expanded_domain.png").string(), ring);
 
     Plot plot;
     plot.title = "dB along t = 1/2: the receiver continued";
@@ -274,9 +274,9 @@ int run(Args& args) {
     plot.add_vline(1, {{0.3, 0.3, 0.3}, 1, 4, 4});
     Image profiles(900, 560, {1, 1, 1});
     plot.draw(profiles, {0, 0, 900, 560});
-    write_png((std::filesystem::path(dir) / "05_extrapolation_profiles.png").string(), profiles);
-    std::cout << "\nwrote " << dir << "/05_expanded_domain.png and " << dir
-              << "/05_extrapolation_profiles.png\n";
+    write_png((std::filesystem::path(dir) / "tutorial_05_extrapolation_profiles.png").string(), profiles);
+    std::cout << "\nwrote " << dir << "/tutorial_05_expanded_domain.png and " << dir
+              << "/tutorial_05_extrapolation_profiles.png\n";
     return 0;
 }
 

@@ -13,7 +13,7 @@
 //   5. reproduces the paper's Table 1 (examples/common/paper_tables.h) with our cost.
 // Run: tutorial_06_fulcrums_and_projection [-o DIR] [--h H] [--min-depth a] [--max-depth b]
 //                                          [--oracle-tolerance T] [--table-rows N]
-// Writes DIR/06_fulcrums.png and DIR/06_truncation.png.
+// Writes DIR/tutorial_06_fulcrums.png and DIR/tutorial_06_truncation.png.
 #include <cmath>
 #include <filesystem>
 #include <iostream>
@@ -250,12 +250,12 @@ int run(Args& args) {
                   << t.n_coefficients << ", kernel evaluations " << t.stats.n_kernel_evals << "\n";
     }
 
-    write_png((std::filesystem::path(dir) / "06_fulcrums.png").string(),
+    write_png((std::filesystem::path(dir) / "tutorial_06_fulcrums.png").string(),
               draw_fulcrums(state, chosen));
     Image truncation(860, 520, {1, 1, 1});
     plot.draw(truncation, {0, 0, 860, 520});
-    write_png((std::filesystem::path(dir) / "06_truncation.png").string(), truncation);
-    std::cout << "\nwrote " << dir << "/06_fulcrums.png and " << dir << "/06_truncation.png\n";
+    write_png((std::filesystem::path(dir) / "tutorial_06_truncation.png").string(), truncation);
+    std::cout << "\nwrote " << dir << "/tutorial_06_fulcrums.png and " << dir << "/tutorial_06_truncation.png\n";
     return 0;
 }
 

@@ -15,8 +15,8 @@ TEST_CASE("tutorial 04: kernel, quadrature and oracle tell the chapter's story",
                                             {"--max-depth", "4", "-o", tmp / "images"});
     INFO(run);
     REQUIRE(run.status == 0);
-    CHECK(std::filesystem::exists(tmp / "images/04_quadrature.png"));
-    CHECK(std::filesystem::exists(tmp / "images/04_oracle_tree.png"));
+    CHECK(std::filesystem::exists(tmp / "images/tutorial_04_quadrature.png"));
+    CHECK(std::filesystem::exists(tmp / "images/tutorial_04_oracle_tree.png"));
     const std::string& out = run.out;
     // Closed forms at h = 0.1, printed with 8 significant digits: 1 / (pi h^2) and
     // h^2 / (pi (h^2 + 1/2)^2).

@@ -15,8 +15,8 @@ TEST_CASE("tutorial 05: extrapolation is what makes the boundary right", "[tutor
                                             {"--depth", "2", "-o", tmp / "images"});
     INFO(run);
     REQUIRE(run.status == 0);
-    CHECK(std::filesystem::exists(tmp / "images/05_expanded_domain.png"));
-    CHECK(std::filesystem::exists(tmp / "images/05_extrapolation_profiles.png"));
+    CHECK(std::filesystem::exists(tmp / "images/tutorial_05_expanded_domain.png"));
+    CHECK(std::filesystem::exists(tmp / "images/tutorial_05_extrapolation_profiles.png"));
     const std::string& out = run.out;
     // Edgefill against the analytic profile (stored 0.000201 and 0.000351 of the maxima): the
     // edgefill tolerance is 1e-4 relative, so a few 1e-4 is the expected size; 1e-3 would mean a

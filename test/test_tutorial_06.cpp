@@ -15,8 +15,8 @@ TEST_CASE("tutorial 06: fulcrums, truncation, unification and Table 1", "[tutori
                                             {"--table-rows", "1", "-o", tmp / "images"});
     INFO(run);
     REQUIRE(run.status == 0);
-    CHECK(std::filesystem::exists(tmp / "images/06_fulcrums.png"));
-    CHECK(std::filesystem::exists(tmp / "images/06_truncation.png"));
+    CHECK(std::filesystem::exists(tmp / "images/tutorial_06_fulcrums.png"));
+    CHECK(std::filesystem::exists(tmp / "images/tutorial_06_truncation.png"));
     const std::string& out = run.out;
     // Stage 5 counts are exact.
     CHECK(number_after(out, "fulcrums at level 3:") == 65);
