@@ -269,8 +269,12 @@ void subdivide_by_oracle(ReceiverState& state, IncrementSampler& sampler) {
                 action[c] = Split;
                 return;
             }
-            const bool contact = contact_plane && touches_shooter(*sampler.receiver().surface,
-                                                                   *contact_plane, cell.rect());
+            // Whether the cell touches the shooter, asked only when an answer matters.
+            const bool ask = contact_plane && (cell.level < opt.contact_depth ||
+                                               (opt.contact_oracle_test != opt.oracle_test &&
+                                                cell.level < opt.max_depth));
+            const bool contact =
+                ask && touches_shooter(*sampler.receiver().surface, *contact_plane, cell.rect());
             if (cell.level < opt.contact_depth && contact) {
                 action[c] = Split;
                 return;
