@@ -1284,3 +1284,49 @@ TEST_CASE("shadow: horizon clipping integrates exactly what the tangent plane le
                             << " unclipped\n";
     }
 }
+
+TEST_CASE("shadow: occluders_toward with a limit gives the whole list or more than the limit",
+          "[shadow]") {
+    // A unit shooter at z = 1 facing down over a unit receiver at z = 0, with 150 random
+    // triangles between them: more candidates than exact_limit, so the octree lists them. For
+    // points of the receiver, the list under a limit L must be the whole list when that has at
+    // most L polygons, and otherwise more than L of its polygons, increasing and distinct (the
+    // paper's fractions then cast their rays through the octree, which needs no list).
+    std::mt19937 rng(77);
+    std::uniform_real_distribution<double> u(0, 1);
+    const Surface shooter = Surface::planar_quad({0, 0, 1}, {0, 1, 1}, {1, 1, 1}, {1, 0, 1});
+    const Surface receiver = Surface::planar_quad({0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0});
+    std::vector<Polygon> polygons;
+    polygons.push_back(make_polygon(quad_polygon(shooter), 0));
+    polygons.push_back(make_polygon(quad_polygon(receiver), 1));
+    for (int i = 0; i < 150; ++i)
+        polygons.push_back(make_polygon(
+            random_triangle(rng, {u(rng), u(rng), 0.1 + 0.8 * u(rng)}, 0.08), 2 + i));
+    const Octree octree(polygons, OctreeOptions{6, 4});
+    const OcclusionContext ctx = make_occlusion_context(octree, shooter, 0, receiver, 1, 0);
+    REQUIRE(static_cast<int>(ctx.candidates.size()) > ctx.exact_limit);
+    const ShooterPlane plane = make_shooter_plane(shooter);
+    int n_cut = 0, n_whole = 0;
+    for (int k = 0; k < 40; ++k) {
+        const Vec3 p{u(rng), u(rng), 0};
+        const std::vector<int> all = occluders_toward(ctx, plane, p);
+        REQUIRE(std::is_sorted(all.begin(), all.end()));
+        for (size_t limit : {size_t(0), size_t(1), size_t(5), max_listed_occluders, size_t(1000)}) {
+            const std::vector<int> some = occluders_toward(ctx, plane, p, limit);
+            CAPTURE(k, limit, all.size(), some.size());
+            if (all.size() <= limit) {
+                CHECK(some == all);
+                ++n_whole;
+                continue;
+            }
+            ++n_cut;
+            CHECK(some.size() > limit);
+            CHECK(std::is_sorted(some.begin(), some.end()));
+            CHECK(std::adjacent_find(some.begin(), some.end()) == some.end());
+            CHECK(std::includes(all.begin(), all.end(), some.begin(), some.end()));
+        }
+    }
+    // Both branches ran (the triangles are dense enough that most pyramids hold many).
+    CHECK(n_cut > 20);
+    CHECK(n_whole > 20);
+}
