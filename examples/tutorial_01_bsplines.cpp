@@ -36,14 +36,6 @@ const char* const usage =
     "  --order M    the order m of parts 2-4, 2..8 (default 4: cubic)\n"
     "  --level J    dyadic points i / 2^J of part 4, 0..6 (default 2)\n";
 
-// The folder of the images: created when missing, refused when it is a file.
-std::string image_folder(const std::string& dir) {
-    std::error_code ec;
-    std::filesystem::create_directories(dir, ec);
-    if (!std::filesystem::is_directory(dir)) throw OutputError(dir, "cannot create the folder");
-    return dir;
-}
-
 // The largest |g(x)| over n + 1 equally spaced points of [a, b].
 template <class G>
 double max_abs_on(G&& g, double a, double b, int n = 4000) {
@@ -109,7 +101,7 @@ int run(Args& args) {
     const int j1 = args.integer("--level", 2, 0, 6);
     args.finish();
     const std::string png =
-        (std::filesystem::path(image_folder(dir)) / "tutorial_01_bsplines.png").string();
+        (std::filesystem::path(make_output_folder(dir)) / "tutorial_01_bsplines.png").string();
     check_output_path(png);
 
     // === Part 1. N_m itself (math/bspline.h: bspline, by the Cox-de Boor recursion).

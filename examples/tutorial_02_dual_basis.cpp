@@ -33,14 +33,6 @@ const char* const usage =
     "  -o DIR    folder for the image (default out; created if missing)\n"
     "  --eps E   the appendix's stopping tolerance, 1e-15..1e-3 (default 1e-12)\n";
 
-// The folder of the images: created when missing, refused when it is a file.
-std::string image_folder(const std::string& dir) {
-    std::error_code ec;
-    std::filesystem::create_directories(dir, ec);
-    if (!std::filesystem::is_directory(dir)) throw OutputError(dir, "cannot create the folder");
-    return dir;
-}
-
 // int_a^b g(x) dx for a piecewise polynomial g with integer knots and degree <= 2m - 2 (a
 // product of two splines of order m): Gauss-Legendre with m points on each unit interval is
 // exact, so what we see below is the mathematics, not quadrature error.
@@ -85,7 +77,7 @@ int run(Args& args) {
     args.finish();
     if (!(eps >= 1e-15 && eps <= 1e-3)) throw UsageError("--eps must be in 1e-15..1e-3");
     const std::string png =
-        (std::filesystem::path(image_folder(dir)) / "tutorial_02_dual_basis.png").string();
+        (std::filesystem::path(make_output_folder(dir)) / "tutorial_02_dual_basis.png").string();
     check_output_path(png);
     const int m = 3;  // Table 3's order
 

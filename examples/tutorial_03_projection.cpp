@@ -127,13 +127,6 @@ long cells_in_rhombus(int m, double r) {
     return count;
 }
 
-std::string image_folder(const std::string& dir) {
-    std::error_code ec;
-    std::filesystem::create_directories(dir, ec);
-    if (!std::filesystem::is_directory(dir)) throw OutputError(dir, "cannot create the folder");
-    return dir;
-}
-
 const Rgb colours[] = {{0.12, 0.40, 0.75}, {0.80, 0.20, 0.15}, {0.15, 0.55, 0.25},
                        {0.55, 0.30, 0.65}, {0.85, 0.55, 0.10}, {0.3, 0.3, 0.3}};
 
@@ -149,7 +142,7 @@ int run(Args& args) {
     if (j0 != levels[0] || j1 != levels[1] || j0 < 1 || j0 > j1 || j1 > 7)
         throw UsageError("--levels J0 J1 must be integers with 1 <= J0 <= J1 <= 7");
     if (!(eps >= 1e-12 && eps <= 1e-2)) throw UsageError("--eps must be in 1e-12..1e-2");
-    const std::filesystem::path folder(image_folder(dir));
+    const std::filesystem::path folder(make_output_folder(dir));
     const std::string png_projection = (folder / "tutorial_03_projection.png").string();
     const std::string png_truncation = (folder / "tutorial_03_truncation.png").string();
 

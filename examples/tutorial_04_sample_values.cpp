@@ -129,7 +129,7 @@ int run(Args& args) {
     if (options.min_depth > options.max_depth)
         throw UsageError("--min-depth must not exceed --max-depth");
     if (!(options.oracle_tolerance > 0)) throw UsageError("--oracle-tolerance must be positive");
-    std::filesystem::create_directories(dir);
+    make_output_folder(dir);
     const TransferSetup setup = parallel_squares(h);
     std::cout << "Chapter 4: the sample values of one transfer, parallel unit squares at h = " << h
               << "\n\n";

@@ -138,7 +138,7 @@ int run(Args& args) {
     if (!(h > 0 && h <= 10)) throw UsageError("--h must be in (0, 10]");
     if (!(options.truncation_eps > 0 && options.truncation_eps < 1))
         throw UsageError("--eps must be in (0, 1)");
-    std::filesystem::create_directories(dir);
+    make_output_folder(dir);
     const int m = options.m, d = options.max_depth;
     const TransferSetup setup = parallel_squares(h);
     const SplineField unshot = SplineField::constant(m, 0, {1, 1, 1});

@@ -111,7 +111,7 @@ int run(Args& args) {
     if (options.min_depth > options.max_depth)
         throw UsageError("--min-depth must not exceed --max-depth");
     if (!(options.oracle_tolerance > 0)) throw UsageError("--oracle-tolerance must be positive");
-    std::filesystem::create_directories(dir);
+    make_output_folder(dir);
     const int m = options.m;
     const TransferSetup setup = parallel_squares(h);
     const SplineField unshot = SplineField::constant(m, 0, {1, 1, 1});

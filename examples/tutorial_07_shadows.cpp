@@ -154,7 +154,7 @@ int run(Args& args) {
         throw UsageError("--shooter-side must be in (0, 1]");
     if (!(options.shadows.threshold > 0 && options.shadows.threshold <= 1))
         throw UsageError("--threshold must be in (0, 1]");
-    std::filesystem::create_directories(dir);
+    make_output_folder(dir);
 
     // The configuration: receiver [0,1]^2 in z = 0, shooter (radiosity 1) in z = 1 facing down,
     // the occluder centred at (0.5, 0.5, 0.5) (radiosity/reference.h).

@@ -60,7 +60,7 @@ int run(Args& args) {
     if (!(convergence >= 0 && convergence < 1)) throw UsageError("--convergence must be in [0, 1)");
     if (shadows != "exact" && shadows != "paper")
         throw UsageError("--shadows must be exact or paper");
-    std::filesystem::create_directories(dir);
+    make_output_folder(dir);
 
     // The scene and its `set` statements as solver options (radiosity/scene_io.h, solver.h),
     // then this chapter's overrides. The octree is the one every shadow ray walks.

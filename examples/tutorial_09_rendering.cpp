@@ -186,7 +186,7 @@ int run(Args& args) {
     if (!(tolerance > 0 && tolerance < 1)) throw UsageError("--tolerance must be in (0, 1)");
     // The reference is checked before the solve, so a missing file costs no time.
     const std::string points_path = find_reference(points_arg);
-    std::filesystem::create_directories(dir);
+    make_output_folder(dir);
 
     // Solve as chapter 8 did, here to the scene's convergence test (or the shot limit).
     Scene scene = load_scene(std::string(MBR_SOURCE_DIR) + "/examples/scenes/cornell_box.scene");

@@ -18,6 +18,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <ostream>
+#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -150,6 +151,20 @@ inline double number_after(const std::string& text, const std::string& label) {
     const double value = std::strtod(begin, &end);
     REQUIRE(end != begin);
     return value;
+}
+
+/// The whitespace-separated fields of the first line of `text` whose first field is `first`
+/// (a row of a program's table); fails the test when there is none.
+inline std::vector<std::string> row_fields(const std::string& text, const std::string& first) {
+    std::istringstream lines(text);
+    for (std::string line; std::getline(lines, line);) {
+        std::istringstream words(line);
+        std::vector<std::string> fields;
+        for (std::string w; words >> w;) fields.push_back(w);
+        if (!fields.empty() && fields[0] == first) return fields;
+    }
+    FAIL("no line starts with \"" << first << "\" in:\n" << text);
+    return {};
 }
 
 }  // namespace mbr::test

@@ -12,22 +12,7 @@
 
 using mbr::test::number_after;
 
-namespace {
-
-/// The whitespace-separated fields of the first line whose first field is `first`.
-std::vector<std::string> row(const std::string& text, const std::string& first) {
-    std::istringstream lines(text);
-    for (std::string line; std::getline(lines, line);) {
-        std::istringstream words(line);
-        std::vector<std::string> fields;
-        for (std::string w; words >> w;) fields.push_back(w);
-        if (!fields.empty() && fields[0] == first) return fields;
-    }
-    FAIL("no line starts with \"" << first << "\" in:\n" << text);
-    return {};
-}
-
-}  // namespace
+using mbr::test::row_fields;
 
 TEST_CASE("tutorial 08: the Cornell box shot by shot", "[tutorial]") {
     mbr::test::TempFolder tmp;
@@ -39,9 +24,9 @@ TEST_CASE("tutorial 08: the Cornell box shot by shot", "[tutorial]") {
     CHECK(std::filesystem::is_regular_file(dir + "/tutorial_08_convergence.png"));
 
     // The largest unshot power shoots first: the light, then the back wall, then the floor.
-    CHECK(row(run.out, "1")[1] == "light");
-    CHECK(row(run.out, "2")[1] == "back_wall");
-    CHECK(row(run.out, "3")[1] == "floor");
+    CHECK(row_fields(run.out, "1")[1] == "light");
+    CHECK(row_fields(run.out, "2")[1] == "back_wall");
+    CHECK(row_fields(run.out, "3")[1] == "floor");
     CHECK(number_after(run.out, "shots:") == 3);
 
     // Bookkeeping: unshot_after = unshot_before - shot + reflected holds to rounding (the terms
@@ -53,7 +38,7 @@ TEST_CASE("tutorial 08: the Cornell box shot by shot", "[tutorial]") {
     // The chapter's numbers, printed with 4 significant digits (margins: 1.5 units of the last
     // digit, so that only a rounding flip between builds passes). The light's shot: 82.89 % of
     // the emitted power arrives, 44.31 % is reflected (the rest of what arrives is absorbed).
-    const std::vector<std::string> first = row(run.out, "1");
+    const std::vector<std::string> first = row_fields(run.out, "1");
     CHECK(std::stod(first[5]) == Approx(82.89).margin(0.015));  // incident_%
     CHECK(std::stod(first[6]) == Approx(44.31).margin(0.015));  // reflected_%
     CHECK(number_after(run.out, "still unshot") == Approx(31.95).margin(0.015));

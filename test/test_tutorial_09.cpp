@@ -14,22 +14,7 @@
 
 using mbr::test::number_after;
 
-namespace {
-
-/// The whitespace-separated fields of the first line whose first field is `first`.
-std::vector<std::string> row(const std::string& text, const std::string& first) {
-    std::istringstream lines(text);
-    for (std::string line; std::getline(lines, line);) {
-        std::istringstream words(line);
-        std::vector<std::string> fields;
-        for (std::string w; words >> w;) fields.push_back(w);
-        if (!fields.empty() && fields[0] == first) return fields;
-    }
-    FAIL("no line starts with \"" << first << "\" in:\n" << text);
-    return {};
-}
-
-}  // namespace
+using mbr::test::row_fields;
 
 TEST_CASE("tutorial 09: the render and the path-traced points", "[tutorial]") {
     mbr::test::TempFolder tmp;
@@ -49,8 +34,8 @@ TEST_CASE("tutorial 09: the render and the path-traced points", "[tutorial]") {
     for (const char* name :
          {"floor1", "floor2", "floor_pen1", "floor_pen3", "back1", "back3", "back_pen1", "red1",
           "red3", "green1", "green3", "ceil1", "stop1", "sfront1", "tfront1", "tside1"})
-        CHECK(row(run.out, name).size() == 12);
-    const std::vector<std::string> stop1 = row(run.out, "stop1");
+        CHECK(row_fields(run.out, name).size() == 12);
+    const std::vector<std::string> stop1 = row_fields(run.out, "stop1");
     CHECK(stop1[1] == "short_top");
     CHECK(std::stod(stop1[9]) == Approx(0.7332).margin(6e-5));
 

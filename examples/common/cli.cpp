@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <iostream>
 #include <new>
 #include <streambuf>
@@ -335,6 +336,15 @@ int run_main(int argc, char** argv, const std::string& usage,
 double now_seconds() {
     using clock = std::chrono::steady_clock;
     return std::chrono::duration<double>(clock::now().time_since_epoch()).count();
+}
+
+std::string make_output_folder(const std::string& dir) {
+    std::error_code ec;
+    std::filesystem::create_directories(dir, ec);
+    if (!std::filesystem::is_directory(dir))
+        throw OutputError(dir, ec ? "cannot create the folder: " + ec.message()
+                                  : "is not a folder");
+    return dir;
 }
 
 }  // namespace mbr

@@ -78,6 +78,10 @@ double read_memory_budget(Args& args);
 /// stderr with the expected memory and time.
 void check_cost(const CostEstimate& cost, double budget, const std::string& run, bool slow);
 
+/// The folder of a program's images (-o DIR): created with its parents when missing; an
+/// OutputError naming it when it cannot be (a file of that name, no permission). Returns dir.
+std::string make_output_folder(const std::string& dir);
+
 /// A results table: printed aligned for people, or as CSV with the exact column names.
 class Table {
 public:
