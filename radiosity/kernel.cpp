@@ -286,16 +286,38 @@ void IncrementIntegrator::take_shadows_apart() {
     // Disjoint convex parts of the union of the shadows (each minus the earlier ones), clipped
     // to the front of the horizon; the cells then see the horizon alone. (Once per view: a
     // second call finds no shadows left.)
+    // DESIGN: the shadows of adjacent faces of one block share edges, and subtracting one from
+    // the other leaves slivers and doubled vertices that rounding makes or unmakes. They carry
+    // no area, but they change the regions' vertex counts between two nearby points, and
+    // edgefill's divided differences (22) need the same regions at both (shadow_on). So parts
+    // below 1e-10 of the shooter's area are dropped, and vertices within rounding of the line
+    // through their neighbours are removed.
+    const double outline_area = std::fabs(signed_area(plane_.outline));
+    const double min_area = 1e-10 * outline_area;
+    auto simplify = [&](ConvexPolygon& polygon) {
+        for (size_t i = 0; polygon.size() > 3 && i < polygon.size();) {
+            const size_t n = polygon.size();
+            const Vec2 a = polygon[(i + n - 1) % n], b = polygon[i], c = polygon[(i + 1) % n];
+            if (std::fabs(cross(b - a, c - b)) <= 1e-12 * outline_area)
+                polygon.erase(polygon.begin() + long(i));
+            else
+                ++i;
+        }
+    };
     for (size_t s = 0; s < view_.shadows.size(); ++s) {
         std::vector<ConvexPolygon> parts{view_.horizon_cuts ? clip(view_.shadows[s], view_.front) : view_.shadows[s]};
         for (size_t t = 0; t < s && !parts.empty(); ++t) {
             std::vector<ConvexPolygon> next;
             for (const ConvexPolygon& part : parts)
-                for (ConvexPolygon& rest : subtract(part, view_.shadows[t])) next.push_back(std::move(rest));
+                for (ConvexPolygon& rest : subtract(part, view_.shadows[t], min_area))
+                    next.push_back(std::move(rest));
             parts = std::move(next);
         }
-        for (ConvexPolygon& part : parts)
-            if (!part.empty()) shadow_regions_.push_back(std::move(part));
+        for (ConvexPolygon& part : parts) {
+            if (part.size() < 3 || std::fabs(signed_area(part)) <= min_area) continue;
+            simplify(part);
+            shadow_regions_.push_back(std::move(part));
+        }
     }
     view_.shadows.clear();
 }
@@ -518,6 +540,10 @@ IncrementIntegrator::Result IncrementIntegrator::integrate(const SurfacePoint& p
         opt.tolerance -= share;
         shadowed = shadow_integral(p, share, near_field, &result.shadow_triangles);
         result.shadow_subtracted = true;
+        result.shadow_tolerance = share;
+        result.shadow_near_field = near_field;
+        for (const ConvexPolygon& region : shadow_regions_)
+            result.shadow_shape.push_back(int(region.size()));
     }
     opt.max_depth = options_.max_depth;
     // Per-node visibility on a curved shooter: a visibility step never passes the n against
@@ -572,9 +598,18 @@ Rgb IncrementIntegrator::integrate_on(const SurfacePoint& p,
     }
     if (made_by && made_by->shadow_subtracted) {
         // The shadowed part on the triangles the partition's point kept: the same refinement
-        // at both points, so a divided difference (22) of them stays smooth.
+        // at both points, so a divided difference (22) of them stays smooth. That needs the
+        // same shadow regions with the same vertices at both points; when they differ (an
+        // occluder's shadow gained or lost a vertex between the two points) the triangles
+        // would land on other parts of the shadow, so it is integrated afresh here.
         take_shadows_apart();
-        sum -= shadow_on(p, made_by->shadow_triangles);
+        std::vector<int> shape;
+        for (const ConvexPolygon& region : shadow_regions_) shape.push_back(int(region.size()));
+        if (shape == made_by->shadow_shape)
+            sum -= shadow_on(p, made_by->shadow_triangles);
+        else if (!shadow_regions_.empty())
+            sum -= shadow_integral(p, made_by->shadow_tolerance, made_by->shadow_near_field,
+                                   nullptr);
     }
     if (!view_.behind_all)
         for (const auto& c : partition) sum += cell_value(p, c.cell, options_.n + 1);

@@ -148,6 +148,9 @@ public:
                                   //   cell values are then those of the remainder)
         bool shadow_subtracted = false;  // the shadowed part was integrated on its own
         std::vector<ShadowTriangle> shadow_triangles;  // its triangles (integrate_on reuses them)
+        std::vector<int> shadow_shape;  // the vertex count of each shadow region they refer to
+        double shadow_tolerance = 0;    // the tolerance the shadowed part was integrated to,
+        double shadow_near_field = 0;   //   and its near-field guard
         bool converged = true;
         std::vector<AcceptedCell<Rgb>> partition;  // the shooter's cells, when asked for
     };

@@ -137,8 +137,9 @@ SolverOptions solver_options(const SolverSettings& s) {
     // docs/method.md).
     o.receiver.contact_depth = s.contact_depth;
     // DESIGN: cells touching a planar shooter may take the Interpolation test of the oracle
-    // (`set contact_oracle interpolation`): what the uniform cube's corners need; the Cornell
-    // box gains less than it costs (ReceiverOptions::contact_oracle_test, docs/method.md).
+    // (`set contact_oracle interpolation`): what the uniform cube's corners need; on the
+    // Cornell box it gains less than it costs (ReceiverOptions::contact_oracle_test,
+    // docs/method.md).
     o.receiver.contact_oracle_test =
         s.contact_oracle == "interpolation" ? OracleTest::Interpolation : OracleTest::Means;
     o.receiver.quadrature.n_pieces = 3;

@@ -18,7 +18,9 @@
 #include <vector>
 
 #include "examples/common/transfer_cli.h"
+#include "radiosity/hidden.h"
 #include "radiosity/kernel.h"
+#include "radiosity/receiver.h"
 #include "radiosity/scene_io.h"
 #include "radiosity/scene_octree.h"
 #include "radiosity/shadow.h"
@@ -372,4 +374,62 @@ TEST_CASE("scale: the Cornell box in millimetres and in metres has the same radi
                    << m.pointwise << " pointwise\n";
     CHECK(binary.of_largest == 0);
     CHECK(m.of_largest < 5e-3);  // twice the largest response to one rounding
+}
+
+TEST_CASE("scale: edgefill's divided differences under a shadow are the same in mm and in m",
+          "[scale]") {
+    // The back wall's first unshot field (after the light's shot) shooting to the ceiling,
+    // whose edge s = 0 sees the wall partly behind the tall block. Edgefill samples a point
+    // just inside the edge and its partner one divided-difference step further in, on the same
+    // shooter partition and shadow triangles (eq. (22)). In metres the tall block's shadow
+    // once had a sliver region more at one point than at the other, the partner's triangles
+    // landed on other parts of the shadow, and the slope came out about 400 where it is 0.023
+    // (the ceiling's B at the edge then went negative). Now the partner integrates its shadow
+    // afresh when the regions differ: the slopes must agree between the units to 1e-3 (the
+    // two quadratures differ by rounding, far below that) and stay below 1.
+    double slopes[2][2][3] = {};
+    const double k[2] = {1, 1e-3};
+    for (int u = 0; u < 2; ++u) {
+        const Scene scene = cornell_box_scaled(k[u]);
+        const Octree octree = build_octree(scene);
+        SolverOptions o = solver_options(scene.settings);
+        o.receiver.max_depth = 5;
+        o.max_shots = 1;
+        ProgressiveSolver solver(scene, octree, o);
+        solver.shoot();  // the light
+        const int wall = scene.find_surface("back_wall"), ceiling = scene.find_surface("ceiling");
+        REQUIRE(wall >= 0);
+        REQUIRE(ceiling >= 0);
+        const SplineField& unshot = solver.solution().unshot[size_t(wall)];
+        const Shooter shooter =
+            make_shooter(scene.surfaces[size_t(wall)].surface, unshot,
+                         std::max(o.receiver.shooter_coarsening, unshot.level() - o.shooter_level));
+        QuadratureOptions q = o.receiver.quadrature;
+        q.abs_tolerance = o.quadrature_share * o.tolerance * solver.radiosity_scale();
+        const OcclusionContext occlusion =
+            make_occlusion_context(octree, scene.surfaces[size_t(wall)].surface, wall,
+                                   scene.surfaces[size_t(ceiling)].surface, ceiling, 2);
+        const Texture& rho = scene.material_of(ceiling).reflectance;
+        const HiddenMask mask = find_hidden(scene.surfaces[size_t(ceiling)].surface, ceiling,
+                                            octree, o.hidden);
+        const ReceiverSurface receiver{&scene.surfaces[size_t(ceiling)].surface,
+                                       [&rho](double s, double t) { return rho.value(s, t); },
+                                       &mask};
+        IncrementSampler sampler(shooter, receiver, q, &occlusion);
+        for (int h = 0; h < 2; ++h)
+            for (int j = 0; j < 3; ++j) {
+                const double leaf = h == 0 ? 1.0 / 32 : 1.0 / 64;  // finest leaf on the edge
+                const double inset = 1e-3 * leaf, delta = 1e-4 * leaf;  // ReceiverOptions
+                Rgb at_p, at_q;
+                sampler.sample_pair(inset, 0.1875 + 0.125 * j, delta, 0, 0, at_p, at_q, nullptr);
+                slopes[u][h][j] = (at_q.r - at_p.r) / delta;
+            }
+    }
+    for (int h = 0; h < 2; ++h)
+        for (int j = 0; j < 3; ++j) {
+            CAPTURE(h, j, slopes[0][h][j], slopes[1][h][j]);
+            CHECK(std::fabs(slopes[0][h][j]) < 1);
+            CHECK(std::fabs(slopes[1][h][j] - slopes[0][h][j]) <=
+                  1e-3 * std::fabs(slopes[0][h][j]) + 1e-6);
+        }
 }
