@@ -281,9 +281,9 @@ void subdivide_by_oracle(ReceiverState& state, IncrementSampler& sampler) {
             }
             if (cell.level >= opt.max_depth) return;  // a leaf
             const int th = thread_index();
-            // DESIGN: a cell touching the shooter takes contact_oracle_test (Interpolation in
-            // scenes): there dB grows like d log d, whose two means agree long before the
-            // spline can follow it.
+            // DESIGN: a cell touching the shooter takes contact_oracle_test (`set
+            // contact_oracle interpolation`): there dB grows like d log d, whose two means
+            // agree long before the spline can follow it.
             const OracleTest test = contact ? opt.contact_oracle_test : opt.oracle_test;
             if (test == OracleTest::Interpolation) {
                 action[c] = interpolation_agrees(cell.rect(), th, &evals[c], &increments[c], scale)

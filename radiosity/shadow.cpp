@@ -119,10 +119,10 @@ OcclusionContext make_occlusion_context(const Octree& octree, const Surface& sho
     // most 1e-3 of the receiver's size: a light hung a hair below the ceiling, a rug on the
     // floor) is no occluder of that receiver. It can only block rays that leave the receiver
     // within 1e-3 of grazing, whose kernel (3) carries a cosine below 1e-3, except under its
-    // footprint, which sees nothing anyway (hidden regions, radiosity/hidden.h). Kept, it turns
-    // exact visibility ill-conditioned there: its shadow seen from a receiving point is a
-    // sliver along the horizon whose area rounding decides, and edgefill's divided differences
-    // (22) of such values came out 5000 times too steep in one unit and right in another.
+    // footprint, which sees nothing anyway (hidden regions, radiosity/hidden.h). Kept, its
+    // shadow seen from a receiving point is a sliver along the horizon whose shape rounding
+    // decides: the kind of shadow that made edgefill's divided differences (22) thousands of
+    // times too steep (IncrementIntegrator::take_shadows_apart).
     const std::optional<Plane> receiver_plane = surface_plane(receiver);
     const double lying = 1e-3 * length(receiver.bounds().extent());
     auto lies_on_receiver = [&](const Polygon& poly) {

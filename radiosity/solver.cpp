@@ -61,8 +61,6 @@ std::vector<double> cholesky_solve(std::vector<double> G, std::vector<double> b,
     return b;
 }
 
-/// The points of one planar surface's hull on the far side of the other's plane (or all on its
-/// plane): nothing can pass between them. Curved surfaces are never ruled out here.
 bool is_planar(const Surface& s) {
     return s.kind() == Surface::Kind::PlanarQuad || s.kind() == Surface::Kind::Disk;
 }
@@ -79,6 +77,8 @@ double front_reach(const Surface& planar, const Surface& other, double* toleranc
     return reach;
 }
 
+/// The points of one planar surface's hull on the far side of the other's plane (or all on its
+/// plane): nothing can pass between them. Curved surfaces are never ruled out here.
 bool behind(const Surface& planar, const Surface& other) {
     if (!is_planar(planar)) return false;
     double tolerance = 0;
@@ -95,9 +95,12 @@ std::uint64_t cell_key(const DyadicCell& c) {
 std::vector<NearContact> near_contacts(const Scene& scene) {
     std::vector<NearContact> found;
     const int n = static_cast<int>(scene.surfaces.size());
-    for (int e : scene.emitters())
+    const std::vector<int> emitters = scene.emitters();
+    std::vector<bool> emits(size_t(n), false);
+    for (int e : emitters) emits[size_t(e)] = true;
+    for (int e : emitters)
         for (int i = 0; i < n; ++i) {
-            if (i == e) continue;
+            if (i == e || (emits[size_t(i)] && i < e)) continue;  // each pair once
             for (const auto& [a, b] : {std::pair{e, i}, std::pair{i, e}}) {
                 const Surface& planar = scene.surfaces[size_t(a)].surface;
                 if (!is_planar(planar)) continue;
