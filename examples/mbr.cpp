@@ -86,12 +86,7 @@ Solution obtain_solution(SceneRun& run, const std::string& load, const std::stri
     if (!load.empty()) {
         errno = 0;
         std::ifstream in(load);
-        if (!in) {
-            const int err = errno;  // the system's reason, e.g. "Permission denied"
-            throw InputError(load, 0,
-                             std::string("cannot open the solution file") +
-                                 (err != 0 ? std::string(": ") + std::strerror(err) : ""));
-        }
+        if (!in) throw InputError(load, 0, "cannot open the solution file" + system_reason());
         solution = load_solution(in, load, run.scene);
         if (report) summary << "loaded " << load << "\n";
     } else {

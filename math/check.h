@@ -3,6 +3,8 @@
 // for data that came from outside (scene files, command lines, images), carrying file and line.
 #pragma once
 
+#include <cerrno>
+#include <cstring>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -55,6 +57,13 @@ namespace detail {
     throw CheckFailure(os.str());
 }
 }  // namespace detail
+
+/// ": REASON" from errno after a failed open (": Permission denied"), or "" when the failure
+/// set none: the tail of an InputError's message. Set errno to 0 before the open.
+inline std::string system_reason() {
+    const int err = errno;
+    return err != 0 ? std::string(": ") + std::strerror(err) : std::string();
+}
 
 }  // namespace mbr
 

@@ -9,7 +9,6 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <cstring>
 #include <fstream>
 #include <istream>
 #include <map>
@@ -336,12 +335,7 @@ std::vector<ProbePoint> parse_probe_points(std::istream& in, const std::string& 
 std::vector<ProbePoint> read_probe_points(const std::string& path) {
     errno = 0;
     std::ifstream in(path, std::ios::binary);
-    if (!in) {
-        const int err = errno;  // the system's reason, e.g. "Permission denied"
-        throw InputError(path, 0,
-                         std::string("cannot open the probe point file") +
-                             (err != 0 ? std::string(": ") + std::strerror(err) : std::string()));
-    }
+    if (!in) throw InputError(path, 0, "cannot open the probe point file" + system_reason());
     return parse_probe_points(in, path);
 }
 

@@ -97,8 +97,9 @@ struct ReceiverOptions {
                                        //   the shooter dB grows like d log d, whose cell means
                                        //   agree long before the spline can follow it (0: off)
     OracleTest contact_oracle_test = OracleTest::Means;  // beyond the paper: the oracle's
-                                       //   test in cells that touch a planar shooter (scenes:
-                                       //   Interpolation, which sees the d log d growth there)
+                                       //   test in cells that touch a planar shooter
+                                       //   (Interpolation sees the d log d growth there; scenes:
+                                       //   `set contact_oracle`)
     double weak_receiver = 0;          // > 0: a receiver whose root samples are all below this
                                        //   many absolute tolerances starts the oracle at depth 0
     double oracle_share = 1;           // the oracle's absolute tolerance: this share of

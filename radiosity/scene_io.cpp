@@ -8,7 +8,6 @@
 #include <cerrno>
 #include <charconv>
 #include <cmath>
-#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <istream>
@@ -219,13 +218,6 @@ std::string resolve(const std::string& from, const std::string& file) {
     fs::path p(file);
     if (p.is_absolute()) return p.string();
     return (fs::path(from).parent_path() / p).string();
-}
-
-/// ": REASON" from errno after a failed open (": Permission denied"), or "" when the failure set
-/// none.
-std::string system_reason() {
-    const int err = errno;
-    return err != 0 ? std::string(": ") + std::strerror(err) : std::string();
 }
 
 /// Why `path` cannot be read as a regular file, or an empty string.

@@ -61,10 +61,6 @@ std::vector<double> cholesky_solve(std::vector<double> G, std::vector<double> b,
     return b;
 }
 
-bool is_planar(const Surface& s) {
-    return s.kind() == Surface::Kind::PlanarQuad || s.kind() == Surface::Kind::Disk;
-}
-
 /// How far the other surface's hull reaches in front of the planar one's plane (its largest
 /// signed distance), and the plane tolerance of behind() below.
 double front_reach(const Surface& planar, const Surface& other, double* tolerance) {
@@ -80,7 +76,7 @@ double front_reach(const Surface& planar, const Surface& other, double* toleranc
 /// The points of one planar surface's hull on the far side of the other's plane (or all on its
 /// plane): nothing can pass between them. Curved surfaces are never ruled out here.
 bool behind(const Surface& planar, const Surface& other) {
-    if (!is_planar(planar)) return false;
+    if (!planar.is_planar()) return false;
     double tolerance = 0;
     return front_reach(planar, other, &tolerance) <= tolerance;
 }
@@ -103,7 +99,7 @@ std::vector<NearContact> near_contacts(const Scene& scene) {
             if (i == e || (emits[size_t(i)] && i < e)) continue;  // each pair once
             for (const auto& [a, b] : {std::pair{e, i}, std::pair{i, e}}) {
                 const Surface& planar = scene.surfaces[size_t(a)].surface;
-                if (!is_planar(planar)) continue;
+                if (!planar.is_planar()) continue;
                 double tolerance = 0;
                 const double reach =
                     front_reach(planar, scene.surfaces[size_t(b)].surface, &tolerance);

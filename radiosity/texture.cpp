@@ -7,7 +7,6 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
-#include <cstring>
 
 #include "math/check.h"
 
@@ -103,10 +102,9 @@ Texture Texture::image(const std::string& path, Rgb scale) {
     // Ask for the size first, so that an absurd header cannot make stb_image allocate gigabytes.
     int width = 0, height = 0, channels = 0;
     if (!stbi_info(path.c_str(), &width, &height, &channels)) {
+        errno = 0;
         std::FILE* f = std::fopen(path.c_str(), "rb");
-        if (!f)
-            throw InputError(path, 0,
-                             std::string("cannot open the texture file: ") + std::strerror(errno));
+        if (!f) throw InputError(path, 0, "cannot open the texture file" + system_reason());
         std::fclose(f);
         const char* why = stbi_failure_reason();
         throw InputError(
