@@ -30,8 +30,13 @@ void clip_into(const ConvexPolygon& polygon, const HalfPlane& h, ConvexPolygon& 
         const double va = h.value(a), vb = h.value(b);
         if (va >= 0) out.push_back(a);
         // The edge crosses the line strictly (an end on the line is kept as a vertex already,
-        // or is the next edge's start): add the crossing point.
-        if ((va > 0 && vb < 0) || (va < 0 && vb > 0)) out.push_back(a + (va / (va - vb)) * (b - a));
+        // or is the next edge's start): add the crossing point, measured from the end nearer
+        // the line. A shadow's vertex can lie 1e7 times further out than the shooter (an
+        // occluder at nearly the height of the receiving point): from there, the crossing
+        // would carry that vertex's rounding, 1e7 times the shooter's.
+        if ((va > 0 && vb < 0) || (va < 0 && vb > 0))
+            out.push_back(std::fabs(va) <= std::fabs(vb) ? a + (va / (va - vb)) * (b - a)
+                                                         : b + (vb / (vb - va)) * (a - b));
     }
     // Vertices on the line can still meet at one point (a polygon touching the line): drop
     // repeated consecutive vertices, so every edge has a length.
@@ -83,6 +88,28 @@ std::vector<ConvexPolygon> subtract(const ConvexPolygon& a, const ConvexPolygon&
     }
     // What is left of a lies inside b: removed.
     return pieces;
+}
+
+void remove_flat_vertices(ConvexPolygon& polygon, double tolerance) {
+    for (size_t i = 0; polygon.size() > 3 && i < polygon.size();) {
+        const size_t n = polygon.size();
+        const Vec2 a = polygon[(i + n - 1) % n], b = polygon[i], c = polygon[(i + 1) % n];
+        // b's distance from the line a c, times |c - a|
+        if (std::fabs(cross(b - a, c - a)) <= tolerance * std::sqrt(dot(c - a, c - a)))
+            polygon.erase(polygon.begin() + long(i));
+        else
+            ++i;
+    }
+}
+
+void start_at_canonical_vertex(ConvexPolygon& polygon) {
+    // Not an axis: the sides of axis-aligned scenes would tie (two vertices equally low, and
+    // rounding choosing between them).
+    const Vec2 direction{0.54030230586813977, 0.84147098480789650};  // (cos 1, sin 1)
+    size_t first = 0;
+    for (size_t i = 1; i < polygon.size(); ++i)
+        if (dot(direction, polygon[i]) < dot(direction, polygon[first])) first = i;
+    std::rotate(polygon.begin(), polygon.begin() + long(first), polygon.end());
 }
 
 ConvexPolygon convex_hull(std::vector<Vec2> points) {

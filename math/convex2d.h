@@ -41,6 +41,19 @@ ConvexPolygon intersect(const ConvexPolygon& a, const ConvexPolygon& b);
 std::vector<ConvexPolygon> subtract(const ConvexPolygon& a, const ConvexPolygon& b,
                                     double min_area = 0);
 
+/// Removes the vertices within `tolerance` of the line through their two neighbours (repeated
+/// and collinear vertices, and their near versions that rounding leaves), keeping at least
+/// three. A near-repeated vertex would give the polygon an edge of no length whose line points
+/// anywhere, and subtract() would cut along it.
+void remove_flat_vertices(ConvexPolygon& polygon, double tolerance);
+
+/// Rotates the vertex list so that it starts at the vertex lowest along one fixed generic
+/// direction (angle 1 radian). A fan of triangles from the first vertex then depends on the
+/// polygon alone, not on where clipping happened to start its list: two polygons that differ
+/// by rounding (a scene in other units, a nearby receiving point) get the same fan, and a
+/// quadrature over the fan the same error pattern.
+void start_at_canonical_vertex(ConvexPolygon& polygon);
+
 /// The convex hull of points, counter-clockwise (Andrew's monotone chain); collinear points on
 /// its edges are dropped.
 ConvexPolygon convex_hull(std::vector<Vec2> points);

@@ -288,22 +288,17 @@ void IncrementIntegrator::take_shadows_apart() {
     // second call finds no shadows left.)
     // DESIGN: the shadows of adjacent faces of one block share edges, and subtracting one from
     // the other leaves slivers and doubled vertices that rounding makes or unmakes. They carry
-    // no area, but they change the regions' vertex counts between two nearby points, and
-    // edgefill's divided differences (22) need the same regions at both (shadow_on). So parts
-    // below 1e-10 of the shooter's area are dropped, and vertices within rounding of the line
-    // through their neighbours are removed.
+    // no area, but they change the regions' vertex counts, and with them the fan triangles
+    // shadow_integral refines: between two nearby points (edgefill's divided differences (22)
+    // need the same regions at both, shadow_on) and between one scene in two units (the
+    // triangles' quadrature errors differ by up to the tolerance). The projection from p
+    // magnifies rounding (up to 1e7 times near p's height, blocked_view), so vertices stray by
+    // about 1e-10 of the shooter's size: parts below 1e-8 of the shooter's area are dropped,
+    // and vertices within 1e-8 of its size of the line through their neighbours are removed
+    // (each changes the shadow's area by about 1e-8 of the shooter's).
     const double outline_area = std::fabs(signed_area(plane_.outline));
-    const double min_area = 1e-10 * outline_area;
-    auto simplify = [&](ConvexPolygon& polygon) {
-        for (size_t i = 0; polygon.size() > 3 && i < polygon.size();) {
-            const size_t n = polygon.size();
-            const Vec2 a = polygon[(i + n - 1) % n], b = polygon[i], c = polygon[(i + 1) % n];
-            if (std::fabs(cross(b - a, c - b)) <= 1e-12 * outline_area)
-                polygon.erase(polygon.begin() + long(i));
-            else
-                ++i;
-        }
-    };
+    const double min_area = 1e-8 * outline_area;
+    const double min_offset = 1e-8 * std::sqrt(outline_area);
     for (size_t s = 0; s < view_.shadows.size(); ++s) {
         std::vector<ConvexPolygon> parts{view_.horizon_cuts ? clip(view_.shadows[s], view_.front) : view_.shadows[s]};
         for (size_t t = 0; t < s && !parts.empty(); ++t) {
@@ -315,7 +310,8 @@ void IncrementIntegrator::take_shadows_apart() {
         }
         for (ConvexPolygon& part : parts) {
             if (part.size() < 3 || std::fabs(signed_area(part)) <= min_area) continue;
-            simplify(part);
+            remove_flat_vertices(part, min_offset);
+            start_at_canonical_vertex(part);  // its fan: the same in any unit
             shadow_regions_.push_back(std::move(part));
         }
     }
@@ -388,7 +384,12 @@ IncrementIntegrator::PointSpan IncrementIntegrator::horizon_points(const QuadCel
     if (it == horizon_cache_.end()) {
         if (horizon_cache_.size() > 200000) horizon_cache_.clear();  // bound it; values never depend on it
         std::vector<ShooterPoint> pts;
-        const ConvexPolygon piece = clip(image, view_.front);
+        ConvexPolygon piece = clip(image, view_.front);
+        // A horizon through a corner of the cell leaves a near-repeated vertex where rounding
+        // decides, and with it a fan triangle of no area (its points cost evaluations and add
+        // nothing): removed, with the other vertices within 1e-9 of the cell's size of flat.
+        remove_flat_vertices(piece, 1e-9 * std::sqrt(std::fabs(signed_area(image))));
+        start_at_canonical_vertex(piece);
         const TriangleRule& rule = tri_rules_[n];
         const Rgb constant_b = unshot_constant_ ? shooter_.unshot.coefficient(0, 0) : Rgb{};
         for (size_t k = 1; k + 1 < piece.size(); ++k) {

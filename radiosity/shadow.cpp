@@ -349,11 +349,19 @@ BlockedView blocked_view(const ShooterPlane& plane, Vec3 p, Vec3 n_p,
                                dot(receiver_plane->normal, plane.origin) - receiver_plane->offset};
     else
         view.front = HalfPlane{{dot(n_p, plane.e1), dot(n_p, plane.e2)}, dot(n_p, plane.origin - p)};
+    // DESIGN: a corner within 1e-9 of the shooter's size of the horizon line lies on it. A
+    // shooter sharing an edge with the receiver (the walls of a box) has two corners on the
+    // line, and rounding would put them in front or behind by turns: the horizon would then cut
+    // the cells along that edge or not, and their rules (triangles or the tensor rule) differ
+    // by the quadrature's error, so that one scene in two units would differ by it.
+    const double outline_area = std::fabs(signed_area(plane.outline));
+    const double size = std::sqrt(outline_area), min_shadow_area = 1e-8 * outline_area;
+    view.front_tolerance = 1e-9 * size;
     int n_front = 0, n_behind = 0;
     for (const Vec2& q : plane.corner) {
         const double v = view.front.value(q);
-        if (v > 0) ++n_front;
-        if (v < 0) ++n_behind;
+        if (v > view.front_tolerance) ++n_front;
+        if (v < -view.front_tolerance) ++n_behind;
     }
     if (n_front == 0) {
         view.behind_all = true;
@@ -422,9 +430,19 @@ BlockedView blocked_view(const ShooterPlane& plane, Vec3 p, Vec3 n_p,
         if (area < 0) std::reverse(shadow.begin(), shadow.end());
         if (std::fabs(area) <= 0) continue;  // an occluder seen edge-on hides nothing
         shadow = intersect(shadow, plane.outline);
-        if (!shadow.empty()) view.shadows.push_back(std::move(shadow));
+        // DESIGN: a shadow below 1e-8 of the shooter's area is dropped: an occluder touching
+        // the shooter along its outline (a neighbouring face) leaves a sliver of no area, whose
+        // nearly coincident vertices give edge lines pointing anywhere (see below).
+        if (!shadow.empty() && std::fabs(signed_area(shadow)) > min_shadow_area)
+            view.shadows.push_back(std::move(shadow));
     }
     merge_shadows(view.shadows);
+    // DESIGN: vertices within 1e-8 of the shooter's size of the line through their neighbours
+    // are removed (changing a shadow's area by about 1e-8 of the shooter's). Clipping and the
+    // hulls of merged faces leave such vertices where rounding decides, and an edge between
+    // two nearly equal vertices has a line pointing anywhere, along which the shadow stage
+    // would cut (subtract, classify).
+    for (ConvexPolygon& shadow : view.shadows) remove_flat_vertices(shadow, 1e-8 * size);
     return view;
 }
 
@@ -479,8 +497,8 @@ CellVisibility classify_cell(const ConvexPolygon& cell, const BlockedView& view,
         int n_front = 0, n_behind = 0;
         for (const Vec2& q : cell) {
             const double v = view.front.value(q);
-            if (v > 0) ++n_front;
-            if (v < 0) ++n_behind;
+            if (v > view.front_tolerance) ++n_front;
+            if (v < -view.front_tolerance) ++n_behind;
         }
         if (n_front == 0) return CellVisibility::hidden;
         cut = n_behind > 0;
@@ -513,6 +531,12 @@ std::vector<ConvexPolygon> visible_pieces(const ConvexPolygon& cell, const Block
         }
         pieces = std::move(next);
         if (pieces.empty()) break;
+    }
+    // The pieces' fans (pieces_value) follow the geometry, not where clipping began nor which
+    // near-repeated vertices rounding left (each would add a fan triangle of no area).
+    for (ConvexPolygon& piece : pieces) {
+        remove_flat_vertices(piece, 1e-9 * std::sqrt(std::fabs(signed_area(cell))));
+        start_at_canonical_vertex(piece);
     }
     return pieces;
 }

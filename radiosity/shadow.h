@@ -128,6 +128,7 @@ struct BlockedView {
     bool behind_all = false;             // the whole shooter is behind the horizon
     bool horizon_cuts = false;           // the horizon line crosses the shooter
     HalfPlane front;                     // the visible side of the horizon line
+    double front_tolerance = 0;          // points within it of the line lie on it
     std::vector<ConvexPolygon> shadows;  // projected occluders (counter-clockwise)
     bool use_rays = false;               // too many occluders for projection (exact_limit):
                                          //   visibility by one ray per quadrature node

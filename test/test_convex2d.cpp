@@ -136,6 +136,67 @@ TEST_CASE("convex2d: clip by a line through vertices repeats no vertex and leave
     CHECK(vertex.empty());
 }
 
+TEST_CASE("convex2d: clip measures a crossing from the end nearer the line", "[convex2d]") {
+    // A shadow's vertex can lie 1e9 times further out than the shooter it is clipped to. The
+    // crossing of the edge from (1e9, 1) back to (0, 1) with x = 1 is (1, 1): measured from
+    // the far end, it carried that end's rounding (about 1e-7); from the near end it is exact
+    // to rounding of the shooter's own size.
+    const ConvexPolygon far_triangle{{0, 0}, {1e9, 1}, {0, 1}};
+    const ConvexPolygon kept = clip(far_triangle, HalfPlane{{-1, 0}, 1});  // x <= 1
+    CAPTURE(kept);
+    REQUIRE(kept.size() == 4);
+    int on_line = 0;
+    for (Vec2 q : kept)
+        if (q.x > 0.5) {
+            ++on_line;
+            CHECK(std::fabs(q.x - 1) <= 1e-15);
+        }
+    CHECK(on_line == 2);
+    CHECK(signed_area(kept) == Approx(1 - 0.5e-9).epsilon(1e-14));
+}
+
+TEST_CASE("convex2d: remove_flat_vertices drops repeated and collinear vertices only",
+          "[convex2d]") {
+    // The unit square with a vertex repeated to rounding, one on an edge to 1e-12 and one
+    // truly out of line by 1e-3: one of the repeated pair and the one on the edge go, the
+    // third stays.
+    ConvexPolygon p{{0, 0}, {0.5, -1e-12}, {1, 0}, {1, 1e-14}, {1, 1}, {0.5, 1.001}, {0, 1}};
+    remove_flat_vertices(p, 1e-9);
+    CAPTURE(p);
+    CHECK(same_vertices(p, {{0, 0}, {1, 0}, {1, 1}, {0.5, 1.001}, {0, 1}}, 1e-14));
+    // A triangle stays a triangle, however flat.
+    ConvexPolygon flat{{0, 0}, {1, 0}, {0.5, 1e-15}};
+    remove_flat_vertices(flat, 1e-9);
+    CHECK(flat.size() == 3);
+}
+
+TEST_CASE("convex2d: start_at_canonical_vertex gives the same list whatever the first vertex",
+          "[convex2d]") {
+    // A fan of triangles from the first vertex must follow the polygon, not where a clip
+    // started its list: every rotation of a hexagon, and the hexagon after a decimal change of
+    // units and back (its coordinates then differ by rounding), start at the same vertex.
+    const ConvexPolygon hexagon{{2, 0}, {3, 1}, {3, 2.5}, {2, 3}, {0.5, 2}, {0.5, 0.7}};
+    ConvexPolygon canonical = hexagon;
+    start_at_canonical_vertex(canonical);
+    for (size_t r = 0; r < hexagon.size(); ++r) {
+        ConvexPolygon p = hexagon;
+        std::rotate(p.begin(), p.begin() + long(r), p.end());
+        for (Vec2& q : p) q = 1e3 * (1e-3 * q);
+        start_at_canonical_vertex(p);
+        CAPTURE(r, p);
+        REQUIRE(p.size() == hexagon.size());
+        for (size_t i = 0; i < p.size(); ++i) {
+            CHECK(p[i].x == Approx(canonical[i].x).epsilon(1e-15));
+            CHECK(p[i].y == Approx(canonical[i].y).epsilon(1e-15));
+        }
+    }
+    // Axis-aligned sides do not tie: the square starts at (0, 0) however it is listed.
+    ConvexPolygon square{{1, 1}, {0, 1}, {0, 0}, {1, 0}};
+    start_at_canonical_vertex(square);
+    CHECK(square[0].x == 0);
+    CHECK(square[0].y == 0);
+}
+
 TEST_CASE("convex2d: intersect against hand-computed polygons", "[convex2d]") {
     // Overlapping squares: [1, 2]^2.
     ConvexPolygon i = intersect(rect(0, 0, 2, 2), rect(1, 1, 3, 3));

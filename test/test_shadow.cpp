@@ -15,6 +15,7 @@
 #include <cmath>
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <random>
 #include <set>
 #include <vector>
@@ -1283,6 +1284,45 @@ TEST_CASE("shadow: horizon clipping integrates exactly what the tangent plane le
                             << "at 1e-6: " << c1.n_evaluations << " clipped, " << c2.n_evaluations
                             << " unclipped\n";
     }
+}
+
+TEST_CASE("shadow: a shooter sharing an edge with the receiver is not cut by its horizon, in any unit",
+          "[shadow]") {
+    // A floor and a wall meeting along an edge, turned to a generic orientation and given in
+    // several decimal units: the wall's two corners on the floor's plane evaluate to rounding
+    // (1e-17 either way), and counted by sign they made the horizon cut the wall or not by
+    // turns, so that its cells along the edge took triangle rules in one unit and the tensor
+    // rule in another (BlockedView::front_tolerance). They must lie on the horizon: never cut,
+    // never all behind. A corner 1e-6 of the wall's size below the floor's plane still cuts.
+    const Vec3 a = normalize(Vec3{1, 0.3, -0.2}), b0 = Vec3{-0.1, 1, 0.4};
+    const Vec3 b = normalize(b0 - dot(b0, a) * a), c = cross(a, b);
+    const Vec3 origin{0.37, -0.21, 0.73};
+    auto at = [&](double k, double x, double y, double z) {  // frame (a, b, c): floor z = 0
+        return k * (origin + x * a + y * b + z * c);
+    };
+    int points = 0;
+    for (double k : {1.0, 1e-6, 1e-3, 0.1, 7.3, 1e3, 1e6}) {
+        const Surface floor = Surface::planar_quad(at(k, 0, 0, 0), at(k, 1, 0, 0), at(k, 1, 1, 0),
+                                                   at(k, 0, 1, 0));
+        const std::optional<Plane> floor_plane = surface_plane(floor);
+        REQUIRE(floor_plane);
+        for (double dip : {0.0, 1e-6}) {
+            // The wall over the floor's edge y = 1, its front facing the floor (-y).
+            const Surface wall = Surface::planar_quad(at(k, 0, 1, -dip), at(k, 0, 1, 1),
+                                                      at(k, 1, 1, 1), at(k, 1, 1, -dip));
+            const ShooterPlane plane = make_shooter_plane(wall);
+            for (double s : {0.1, 0.5, 0.9})
+                for (double t : {0.2, 0.7}) {
+                    const SurfacePoint p = floor.evaluate(s, t);
+                    const BlockedView view = blocked_view(plane, p.position, p.normal, nullptr, &*floor_plane);
+                    CAPTURE(k, dip, s, t);
+                    CHECK_FALSE(view.behind_all);
+                    CHECK(view.horizon_cuts == (dip > 0));
+                    ++points;
+                }
+        }
+    }
+    CHECK(points == 7 * 2 * 6);
 }
 
 TEST_CASE("shadow: occluders_toward with a limit gives the whole list or more than the limit",
