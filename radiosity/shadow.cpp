@@ -355,7 +355,7 @@ BlockedView blocked_view(const ShooterPlane& plane, Vec3 p, Vec3 n_p,
     // the cells along that edge or not, and their rules (triangles or the tensor rule) differ
     // by the quadrature's error, so that one scene in two units would differ by it.
     const double outline_area = std::fabs(signed_area(plane.outline));
-    const double size = std::sqrt(outline_area), min_shadow_area = 1e-8 * outline_area;
+    const double size = std::sqrt(outline_area), min_shadow_area = 1e-10 * outline_area;
     view.front_tolerance = 1e-9 * size;
     int n_front = 0, n_behind = 0;
     for (const Vec2& q : plane.corner) {
@@ -430,19 +430,19 @@ BlockedView blocked_view(const ShooterPlane& plane, Vec3 p, Vec3 n_p,
         if (area < 0) std::reverse(shadow.begin(), shadow.end());
         if (std::fabs(area) <= 0) continue;  // an occluder seen edge-on hides nothing
         shadow = intersect(shadow, plane.outline);
-        // DESIGN: a shadow below 1e-8 of the shooter's area is dropped: an occluder touching
+        // DESIGN: a shadow below 1e-10 of the shooter's area is dropped: an occluder touching
         // the shooter along its outline (a neighbouring face) leaves a sliver of no area, whose
         // nearly coincident vertices give edge lines pointing anywhere (see below).
         if (!shadow.empty() && std::fabs(signed_area(shadow)) > min_shadow_area)
             view.shadows.push_back(std::move(shadow));
     }
     merge_shadows(view.shadows);
-    // DESIGN: vertices within 1e-8 of the shooter's size of the line through their neighbours
-    // are removed (changing a shadow's area by about 1e-8 of the shooter's). Clipping and the
+    // DESIGN: vertices within 1e-10 of the shooter's size of the line through their neighbours
+    // are removed (changing a shadow's area by about 1e-10 of the shooter's). Clipping and the
     // hulls of merged faces leave such vertices where rounding decides, and an edge between
     // two nearly equal vertices has a line pointing anywhere, along which the shadow stage
     // would cut (subtract, classify).
-    for (ConvexPolygon& shadow : view.shadows) remove_flat_vertices(shadow, 1e-8 * size);
+    for (ConvexPolygon& shadow : view.shadows) remove_flat_vertices(shadow, 1e-10 * size);
     return view;
 }
 
