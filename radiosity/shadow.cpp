@@ -349,14 +349,21 @@ BlockedView blocked_view(const ShooterPlane& plane, Vec3 p, Vec3 n_p,
                                dot(receiver_plane->normal, plane.origin) - receiver_plane->offset};
     else
         view.front = HalfPlane{{dot(n_p, plane.e1), dot(n_p, plane.e2)}, dot(n_p, plane.origin - p)};
-    // DESIGN: a corner within 1e-9 of the shooter's size of the horizon line lies on it. A
-    // shooter sharing an edge with the receiver (the walls of a box) has two corners on the
-    // line, and rounding would put them in front or behind by turns: the horizon would then cut
-    // the cells along that edge or not, and their rules (triangles or the tensor rule) differ
-    // by the quadrature's error, so that one scene in two units would differ by it.
+    // DESIGN: a corner within rounding of the horizon line lies on it: within 1e-12 of the
+    // magnitudes its value is computed from (the shooter's size and the planes' distances from
+    // the origin), some 1e4 times their rounding. A shooter sharing an edge with the receiver
+    // (the walls of a box) has two corners on the line, and rounding put them in front or
+    // behind by turns: the horizon then cut the cells along that edge or not, and their rules
+    // (triangles or the tensor rule) differ by the quadrature's error, so that one scene in two
+    // units differed by it. (Not a fraction of the shooter's size alone: a shooter 1e9 times
+    // its distance from the receiver has its corners 1e-9 of its size in front.)
     const double outline_area = std::fabs(signed_area(plane.outline));
     const double size = std::sqrt(outline_area), min_shadow_area = 1e-10 * outline_area;
-    view.front_tolerance = 1e-9 * size;
+    const double magnitude =
+        size + (receiver_plane ? std::fabs(dot(receiver_plane->normal, plane.origin)) +
+                                     std::fabs(receiver_plane->offset)
+                               : std::fabs(dot(n_p, plane.origin)) + std::fabs(dot(n_p, p)));
+    view.front_tolerance = 1e-12 * magnitude;
     int n_front = 0, n_behind = 0;
     for (const Vec2& q : plane.corner) {
         const double v = view.front.value(q);

@@ -116,6 +116,30 @@ TEST_CASE("scale: a shooter 1e-8 the size of its receiver keeps the rea of one 0
     }
 }
 
+TEST_CASE("scale: a shooter 1e9 the size of its distance keeps the rea of one 1e6 its size",
+          "[scale]") {
+    // Issue 11's sweep at the large end: the square of side s from the corner of the unit
+    // square at distance 1 (single_transfer --shooter 0 0 1 0 s 1 s s 1 s 0 1 --receiver
+    // 0 0 0 1 0 0 1 1 0 0 1 0 --depth 3). Side 1e9 once gave rea 27.6 % against 0.0029 % at
+    // 1e6 (absolute tolerances); later 100 %, when the horizon's tolerance was 1e-9 of the
+    // shooter's size (1 unit: the whole shooter lay on the receiver's horizon).
+    const Surface receiver = Surface::planar_quad({0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0});
+    auto corner_square = [&](double s) {
+        return TransferSetup{Surface::planar_quad({0, 0, 1}, {0, s, 1}, {s, s, 1}, {s, 0, 1}),
+                             receiver};
+    };
+    const double rea_large = transfer_rea(corner_square(1e6), 3);
+    REQUIRE(rea_large > 0);
+    for (double s : {1e8, 1e9}) {
+        CAPTURE(s);
+        const double rea = transfer_rea(corner_square(s), 3);
+        mbr::test::report() << "scale: huge shooter, side " << s << ": rea " << rea
+                            << " against " << rea_large << " at side 1e6\n";
+        CHECK(rea < 2 * rea_large);  // the issue's factor 2
+        CHECK(rea > 0.5 * rea_large);
+    }
+}
+
 TEST_CASE("scale: the form factor of a tiny polygon tends to the point-source limit", "[scale]") {
     // The tilted square seen from points of the unit square in z = 0, at distances about 1.
     const std::vector<Vec3> unit = tilted_square(1);
