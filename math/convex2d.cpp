@@ -90,6 +90,18 @@ std::vector<ConvexPolygon> subtract(const ConvexPolygon& a, const ConvexPolygon&
     return pieces;
 }
 
+bool is_sliver(const ConvexPolygon& polygon, double min_width, double min_extent) {
+    if (polygon.size() < 3) return true;
+    Vec2 lo = polygon[0], hi = polygon[0];
+    for (const Vec2& q : polygon) {
+        lo = {std::min(lo.x, q.x), std::min(lo.y, q.y)};
+        hi = {std::max(hi.x, q.x), std::max(hi.y, q.y)};
+    }
+    const Vec2 extent = hi - lo;
+    const double diagonal = std::sqrt(dot(extent, extent));
+    return diagonal <= min_extent || std::fabs(signed_area(polygon)) <= min_width * diagonal;
+}
+
 void remove_flat_vertices(ConvexPolygon& polygon, double tolerance) {
     for (size_t i = 0; polygon.size() > 3 && i < polygon.size();) {
         const size_t n = polygon.size();

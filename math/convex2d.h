@@ -41,6 +41,12 @@ ConvexPolygon intersect(const ConvexPolygon& a, const ConvexPolygon& b);
 std::vector<ConvexPolygon> subtract(const ConvexPolygon& a, const ConvexPolygon& b,
                                     double min_area = 0);
 
+/// True when the polygon is at most `min_width` wide or its bounding box at most `min_extent`
+/// across: fewer than three vertices, an area at most min_width times the box's diagonal (a
+/// strip of length l and width w has area l w and diagonal about l), or a speck. A small but
+/// full polygon, wider than min_width and larger than min_extent, is kept.
+bool is_sliver(const ConvexPolygon& polygon, double min_width, double min_extent);
+
 /// Removes the vertices within `tolerance` of the line through their two neighbours (repeated
 /// and collinear vertices, and their near versions that rounding leaves), keeping at least
 /// three. A near-repeated vertex would give the polygon an edge of no length whose line points

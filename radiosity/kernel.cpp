@@ -291,26 +291,28 @@ void IncrementIntegrator::take_shadows_apart() {
     // no area, but they change the regions' vertex counts, and with them the fan triangles
     // shadow_integral refines: between two nearby points (edgefill's divided differences (22)
     // need the same regions at both, shadow_on) and between one scene in two units (the
-    // triangles' quadrature errors differ by up to the tolerance). Parts below 1e-10 of the
-    // shooter's area are dropped, and vertices within 1e-10 of its size of the line through
-    // their neighbours are removed (each changes the shadow's area by about 1e-10 of the
-    // shooter's). Measured on the Cornell box and test_scale's shadowed floor in decimal
-    // units: with 1e-12 instead, rounding still changes the regions (the kernel-evaluation
-    // counts of some shots differ between units); with 1e-10 no count differs.
-    const double outline_area = std::fabs(signed_area(plane_.outline));
-    const double min_area = 1e-10 * outline_area;
-    const double min_offset = 1e-10 * std::sqrt(outline_area);
+    // triangles' quadrature errors differ by up to the tolerance). Parts at most 1e-10 of the
+    // shooter's size wide or 1e-7 of it across are dropped (is_sliver: the specks rounding
+    // leaves where three shadow edges meet reach 1e-9 of it), and vertices within 1e-10 of
+    // its size of the line through their neighbours are removed. (Not parts below a fraction
+    // of the shooter's area: that would drop a small shadow which hides most of what a point
+    // close to a large shooter sees.) Measured on the Cornell
+    // box and test_scale's shadowed floor in decimal units: with 1e-12 instead, rounding still
+    // changes the regions (the kernel-evaluation counts of some shots differ between units);
+    // with 1e-10 no count differs.
+    const double size = std::sqrt(std::fabs(signed_area(plane_.outline)));
+    const double min_offset = 1e-10 * size;
     for (size_t s = 0; s < view_.shadows.size(); ++s) {
         std::vector<ConvexPolygon> parts{view_.horizon_cuts ? clip(view_.shadows[s], view_.front) : view_.shadows[s]};
         for (size_t t = 0; t < s && !parts.empty(); ++t) {
             std::vector<ConvexPolygon> next;
             for (const ConvexPolygon& part : parts)
-                for (ConvexPolygon& rest : subtract(part, view_.shadows[t], min_area))
+                for (ConvexPolygon& rest : subtract(part, view_.shadows[t]))
                     next.push_back(std::move(rest));
             parts = std::move(next);
         }
         for (ConvexPolygon& part : parts) {
-            if (part.size() < 3 || std::fabs(signed_area(part)) <= min_area) continue;
+            if (is_sliver(part, min_offset, 1e-7 * size)) continue;
             remove_flat_vertices(part, min_offset);
             start_at_canonical_vertex(part);  // its fan: the same in any unit
             shadow_regions_.push_back(std::move(part));

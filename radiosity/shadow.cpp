@@ -358,7 +358,7 @@ BlockedView blocked_view(const ShooterPlane& plane, Vec3 p, Vec3 n_p,
     // units differed by it. (Not a fraction of the shooter's size alone: a shooter 1e9 times
     // its distance from the receiver has its corners 1e-9 of its size in front.)
     const double outline_area = std::fabs(signed_area(plane.outline));
-    const double size = std::sqrt(outline_area), min_shadow_area = 1e-10 * outline_area;
+    const double size = std::sqrt(outline_area);
     const double magnitude =
         size + (receiver_plane ? std::fabs(dot(receiver_plane->normal, plane.origin)) +
                                      std::fabs(receiver_plane->offset)
@@ -437,11 +437,13 @@ BlockedView blocked_view(const ShooterPlane& plane, Vec3 p, Vec3 n_p,
         if (area < 0) std::reverse(shadow.begin(), shadow.end());
         if (std::fabs(area) <= 0) continue;  // an occluder seen edge-on hides nothing
         shadow = intersect(shadow, plane.outline);
-        // DESIGN: a shadow below 1e-10 of the shooter's area is dropped: an occluder touching
-        // the shooter along its outline (a neighbouring face) leaves a sliver of no area, whose
-        // nearly coincident vertices give edge lines pointing anywhere (see below).
-        if (!shadow.empty() && std::fabs(signed_area(shadow)) > min_shadow_area)
-            view.shadows.push_back(std::move(shadow));
+        // DESIGN: a sliver at most 1e-10 of the shooter's size wide (or a speck 1e-7 of it
+        // across) is dropped (is_sliver): an occluder touching the shooter along its outline
+        // (a neighbouring face) leaves one of no area, whose nearly coincident vertices give
+        // edge lines pointing anywhere (see below). Its width, not its area against the
+        // shooter's: seen from a point close to a large shooter, a shadow small beside the
+        // shooter can hide most of what the point sees.
+        if (!is_sliver(shadow, 1e-10 * size, 1e-7 * size)) view.shadows.push_back(std::move(shadow));
     }
     merge_shadows(view.shadows);
     // DESIGN: vertices within 1e-10 of the shooter's size of the line through their neighbours

@@ -170,6 +170,17 @@ TEST_CASE("convex2d: remove_flat_vertices drops repeated and collinear vertices 
     CHECK(flat.size() == 3);
 }
 
+TEST_CASE("convex2d: is_sliver tells thin strips and specks from small full polygons",
+          "[convex2d]") {
+    // A strip 1 long and 1e-12 wide, and a triangle 1e-9 across, are slivers at width 1e-10
+    // and extent 1e-7; a square 1e-6 across is not, however small beside anything else.
+    CHECK(is_sliver({{0, 0}, {1, 0}, {1, 1e-12}, {0, 1e-12}}, 1e-10, 1e-7));
+    CHECK(is_sliver({{0, 0}, {1e-9, 0}, {0, 1e-9}}, 1e-10, 1e-7));
+    CHECK_FALSE(is_sliver(rect(0.3, 0.3, 0.3 + 1e-6, 0.3 + 1e-6), 1e-10, 1e-7));
+    CHECK_FALSE(is_sliver({{0, 0}, {1, 0}, {1, 1e-9}, {0, 1e-9}}, 1e-10, 1e-7));
+    CHECK(is_sliver({{0, 0}, {1, 0}}, 1e-10, 1e-7));
+}
+
 TEST_CASE("convex2d: start_at_canonical_vertex gives the same list whatever the first vertex",
           "[convex2d]") {
     // A fan of triangles from the first vertex must follow the polygon, not where a clip

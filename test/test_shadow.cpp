@@ -996,6 +996,39 @@ TEST_CASE("shadow: exact visibility in (21) matches the shadowed form factor", "
     }
 }
 
+TEST_CASE("shadow: a small shadow under a large shooter is kept", "[shadow]") {
+    // The shooter 1e5 across at height 1 over the unit receiver, and an occluder of side 0.02
+    // at height 0.5 over the receiver's centre: seen from the centre its shadow on the shooter
+    // is 0.04 across, 1.6e-13 of the shooter's area, yet it hides what lies straight above,
+    // where the form factor is largest. Slivers must be told from it by their width, not by
+    // their area against the shooter's (which once dropped such a shadow: I then equalled the
+    // unshadowed F). Exact visibility must match the analytic shadowed form factor.
+    const double side = 1e5;
+    ShadowSetup setup;
+    setup.shooter = Surface::planar_quad({-side / 2, -side / 2, 1}, {-side / 2, side / 2, 1},
+                                         {side / 2, side / 2, 1}, {side / 2, -side / 2, 1});
+    setup.receiver = Surface::planar_quad({0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0});
+    setup.occluders = {square_at(0.5, 0.5, 0.5, 0.01)};
+    const Pair pair(setup);
+    REQUIRE(pair.context.candidates.size() == 1);
+    const std::vector<Vec3> polygon = quad_polygon(setup.shooter);
+    const Shooter shooter = unit_shooter(setup.shooter);  // the integrator keeps a reference
+    for (const bool analytic : {false, true}) {
+        QuadratureOptions options;
+        options.analytic = analytic;
+        IncrementIntegrator integrator(shooter, options, &pair.context);
+        for (double s : {0.5, 0.505, 0.52}) {
+            const SurfacePoint p = setup.receiver.evaluate(s, 0.5);
+            const double full = point_polygon_form_factor(p.position, p.normal, polygon);
+            const double exact = shadowed_form_factor(p.position, p.normal, polygon, setup.occluders[0]);
+            const double I = integrator.integrate(p).value.r;
+            CAPTURE(analytic, s, full, exact, I);
+            REQUIRE(full - exact > 1e-4);  // the shadow matters: 3.5e-4 of F at the centre
+            CHECK(std::fabs(I - exact) <= 1e-4 * full);
+        }
+    }
+}
+
 TEST_CASE("shadow: exact visibility on a curved shooter casts rays and matches the reference",
           "[shadow]") {
     // The parallel unit shooter given as a bilinear patch (the same flat square, but not a
