@@ -293,13 +293,12 @@ void IncrementIntegrator::take_shadows_apart() {
     // need the same regions at both, shadow_on) and between one scene in two units (the
     // triangles' quadrature errors differ by up to the tolerance). Parts at most 1e-10 of the
     // shooter's size wide or 1e-7 of it across are dropped (is_sliver: the specks rounding
-    // leaves where three shadow edges meet reach 1e-9 of it), and vertices within 1e-10 of
-    // its size of the line through their neighbours are removed. (Not parts below a fraction
-    // of the shooter's area: that would drop a small shadow which hides most of what a point
-    // close to a large shooter sees.) Measured on the Cornell
-    // box and test_scale's shadowed floor in decimal units: with 1e-12 instead, rounding still
-    // changes the regions (the kernel-evaluation counts of some shots differ between units);
-    // with 1e-10 no count differs.
+    // leaves where three shadow edges meet are about 1e-9 of it across), and vertices within
+    // 1e-10 of its size of the line through their neighbours are removed. (Not parts below a
+    // fraction of the shooter's area: that would drop a small shadow which hides most of what
+    // a point close to a large shooter sees.) Measured on the Cornell box and test_scale's
+    // shadowed floor in decimal units: with 1e-12 instead, rounding still changes the regions
+    // (the kernel-evaluation counts of some shots differ between units); with 1e-10 none does.
     const double size = std::sqrt(std::fabs(signed_area(plane_.outline)));
     const double min_offset = 1e-10 * size;
     for (size_t s = 0; s < view_.shadows.size(); ++s) {
