@@ -443,7 +443,8 @@ BlockedView blocked_view(const ShooterPlane& plane, Vec3 p, Vec3 n_p,
         // edge lines pointing anywhere (see below). Its width, not its area against the
         // shooter's: seen from a point close to a large shooter, a shadow small beside the
         // shooter can hide most of what the point sees.
-        if (!is_sliver(shadow, 1e-10 * size, 1e-7 * size)) view.shadows.push_back(std::move(shadow));
+        if (!is_sliver(shadow, 1e-10 * size, 1e-7 * size))
+            view.shadows.push_back(std::move(shadow));
     }
     merge_shadows(view.shadows);
     // DESIGN: vertices within 1e-10 of the shooter's size of the line through their neighbours

@@ -360,8 +360,8 @@ Difference solution_difference(const Solution& a, const Solution& b) {
 // once, and the solve must not let that rounding steer any discrete decision: which vertex a
 // shadow's fan starts at (math/convex2d.h, start_at_canonical_vertex), whether a corner on the
 // receiver's plane cuts the horizon (BlockedView::front_tolerance), repeated and collinear
-// vertices and shadows of no area (remove_flat_vertices), or a crossing computed from a
-// vertex 1e7 times further out (clip). Each of these once made a scene in decimal units
+// vertices and shadows of no width (remove_flat_vertices, is_sliver), or a crossing computed
+// from a vertex 1e7 times further out (clip). Each of these once made a scene in decimal units
 // differ by up to the quadrature's tolerance: the shadowed floor by 5.5e-5 to 1.4e-4 of the
 // largest value, the Cornell box in metres by 1.9e-4 (0.56 % at one point). Now both differ
 // by 3e-14 to 5e-14 of the largest value and 1e-12 to 2.5e-12 pointwise, as rounding does.
