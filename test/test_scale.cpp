@@ -133,8 +133,8 @@ TEST_CASE("scale: a shooter 1e9 the size of its distance keeps the rea of one 1e
     for (double s : {1e8, 1e9}) {
         CAPTURE(s);
         const double rea = transfer_rea(corner_square(s), 3);
-        mbr::test::report() << "scale: huge shooter, side " << s << ": rea " << rea
-                            << " against " << rea_large << " at side 1e6\n";
+        mbr::test::report() << "scale: huge shooter, side " << s << ": rea " << rea << " against "
+                            << rea_large << " at side 1e6\n";
         CHECK(rea < 2 * rea_large);  // the issue's factor 2
         CHECK(rea > 0.5 * rea_large);
     }

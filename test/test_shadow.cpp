@@ -1337,8 +1337,8 @@ TEST_CASE("shadow: a shooter sharing an edge with its receiver is not cut by its
     };
     int points = 0;
     for (double k : {1.0, 1e-6, 1e-3, 0.1, 7.3, 1e3, 1e6}) {
-        const Surface floor = Surface::planar_quad(at(k, 0, 0, 0), at(k, 1, 0, 0), at(k, 1, 1, 0),
-                                                   at(k, 0, 1, 0));
+        const Surface floor =
+            Surface::planar_quad(at(k, 0, 0, 0), at(k, 1, 0, 0), at(k, 1, 1, 0), at(k, 0, 1, 0));
         const std::optional<Plane> floor_plane = surface_plane(floor);
         REQUIRE(floor_plane);
         for (double dip : {0.0, 1e-6}) {
