@@ -49,6 +49,16 @@ std::vector<Vec3> tilted_square(double s) {
     return {at(0, 0), at(1, 0), at(1, 1), at(0, 1)};
 }
 
+/// The unit square in z = 0, facing up: the receiver of issue 11's sweep of shooter sizes.
+Surface unit_receiver() {
+    return Surface::planar_quad({0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0});
+}
+
+/// The sweep's shooter: the square of side s from the receiver's corner, at distance 1.
+TransferSetup corner_square(double s) {
+    return {Surface::planar_quad({0, 0, 1}, {0, s, 1}, {s, s, 1}, {s, 0, 1}), unit_receiver()};
+}
+
 /// rea of one transfer (shooter radiosity 1, reflectance 1) at uniform depth d, on the
 /// 256 x 256 grid of the tables.
 double transfer_rea(const TransferSetup& setup, int d) {
@@ -93,14 +103,9 @@ TEST_CASE("scale: a shooter 1e-8 the size of its receiver keeps the rea of one 0
     // formula's cross products). The tilted square away from the origin also needs the
     // shooter's plane to keep its digits: its Newell normal summed over absolute corners gave
     // rea 29 % at s = 1e-8.
-    const Surface receiver = Surface::planar_quad({0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0});
-    auto corner_square = [&](double s) {
-        return TransferSetup{Surface::planar_quad({0, 0, 1}, {0, s, 1}, {s, s, 1}, {s, 0, 1}),
-                             receiver};
-    };
     auto tilted = [&](double s) {
         const std::vector<Vec3> c = tilted_square(s);
-        return TransferSetup{Surface::planar_quad(c[0], c[1], c[2], c[3]), receiver};
+        return TransferSetup{Surface::planar_quad(c[0], c[1], c[2], c[3]), unit_receiver()};
     };
     for (bool at_corner : {true, false}) {
         CAPTURE(at_corner);
@@ -123,11 +128,6 @@ TEST_CASE("scale: a shooter 1e9 the size of its distance keeps the rea of one 1e
     // 0 0 0 1 0 0 1 1 0 0 1 0 --depth 3). Side 1e9 once gave rea 27.6 % against 0.0029 % at
     // 1e6 (absolute tolerances); later 100 %, when the horizon's tolerance was 1e-9 of the
     // shooter's size (1 unit: the whole shooter lay on the receiver's horizon).
-    const Surface receiver = Surface::planar_quad({0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0});
-    auto corner_square = [&](double s) {
-        return TransferSetup{Surface::planar_quad({0, 0, 1}, {0, s, 1}, {s, s, 1}, {s, 0, 1}),
-                             receiver};
-    };
     const double rea_large = transfer_rea(corner_square(1e6), 3);
     REQUIRE(rea_large > 0);
     for (double s : {1e8, 1e9}) {
