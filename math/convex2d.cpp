@@ -90,15 +90,21 @@ std::vector<ConvexPolygon> subtract(const ConvexPolygon& a, const ConvexPolygon&
     return pieces;
 }
 
+Rect bounding_rect(const ConvexPolygon& polygon) {
+    Rect r{HUGE_VAL, -HUGE_VAL, HUGE_VAL, -HUGE_VAL};
+    for (const Vec2& q : polygon) {
+        r.x0 = std::min(r.x0, q.x);
+        r.x1 = std::max(r.x1, q.x);
+        r.y0 = std::min(r.y0, q.y);
+        r.y1 = std::max(r.y1, q.y);
+    }
+    return r;
+}
+
 bool is_sliver(const ConvexPolygon& polygon, double min_width, double min_extent) {
     if (polygon.size() < 3) return true;
-    Vec2 lo = polygon[0], hi = polygon[0];
-    for (const Vec2& q : polygon) {
-        lo = {std::min(lo.x, q.x), std::min(lo.y, q.y)};
-        hi = {std::max(hi.x, q.x), std::max(hi.y, q.y)};
-    }
-    const Vec2 extent = hi - lo;
-    const double diagonal = std::sqrt(dot(extent, extent));
+    const Rect box = bounding_rect(polygon);
+    const double diagonal = std::sqrt(box.width() * box.width() + box.height() * box.height());
     return diagonal <= min_extent || std::fabs(signed_area(polygon)) <= min_width * diagonal;
 }
 

@@ -41,6 +41,9 @@ ConvexPolygon intersect(const ConvexPolygon& a, const ConvexPolygon& b);
 std::vector<ConvexPolygon> subtract(const ConvexPolygon& a, const ConvexPolygon& b,
                                     double min_area = 0);
 
+/// The smallest axis-aligned rectangle holding the polygon (x0 > x1 when it is empty).
+Rect bounding_rect(const ConvexPolygon& polygon);
+
 /// True when the polygon is at most `min_width` wide or its bounding box at most `min_extent`
 /// across: fewer than three vertices, an area at most min_width times the box's diagonal (a
 /// strip of length l and width w has area l w and diagonal about l), or a speck. A small but

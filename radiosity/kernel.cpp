@@ -299,8 +299,7 @@ void IncrementIntegrator::take_shadows_apart() {
     // a point close to a large shooter sees.) Measured on the Cornell box and test_scale's
     // shadowed floor in decimal units: with 1e-12 instead, rounding still changes the regions
     // (the kernel-evaluation counts of some shots differ between units); with 1e-10 none does.
-    const double size = std::sqrt(std::fabs(signed_area(plane_.outline)));
-    const double min_offset = 1e-10 * size;
+    const double min_offset = 1e-10 * plane_.size;
     for (size_t s = 0; s < view_.shadows.size(); ++s) {
         std::vector<ConvexPolygon> parts{view_.horizon_cuts ? clip(view_.shadows[s], view_.front) : view_.shadows[s]};
         for (size_t t = 0; t < s && !parts.empty(); ++t) {
@@ -311,7 +310,7 @@ void IncrementIntegrator::take_shadows_apart() {
             parts = std::move(next);
         }
         for (ConvexPolygon& part : parts) {
-            if (is_sliver(part, min_offset, 1e-7 * size)) continue;
+            if (is_sliver(part, min_offset, 1e-7 * plane_.size)) continue;
             remove_flat_vertices(part, min_offset);
             start_at_canonical_vertex(part);  // its fan: the same in any unit
             shadow_regions_.push_back(std::move(part));

@@ -229,6 +229,7 @@ ShooterPlane make_shooter_plane(const Surface& quad) {
         sp.inverse_row1 = Vec2{-e.y, e.x} * (1 / det);
     }
     if (signed_area(sp.outline) < 0) std::reverse(sp.outline.begin(), sp.outline.end());
+    sp.size = std::sqrt(std::fabs(signed_area(sp.outline)));
     return sp;
 }
 
@@ -357,8 +358,7 @@ BlockedView blocked_view(const ShooterPlane& plane, Vec3 p, Vec3 n_p,
     // (triangles or the tensor rule) differ by the quadrature's error, so that one scene in two
     // units differed by it. (Not a fraction of the shooter's size alone: a shooter 1e9 times
     // its distance from the receiver has its corners 1e-9 of its size in front.)
-    const double outline_area = std::fabs(signed_area(plane.outline));
-    const double size = std::sqrt(outline_area);
+    const double size = plane.size;
     const double magnitude =
         size + (receiver_plane ? std::fabs(dot(receiver_plane->normal, plane.origin)) +
                                      std::fabs(receiver_plane->offset)
@@ -464,33 +464,22 @@ void merge_shadows(std::vector<ConvexPolygon>& shadows) {
     // union, until no pair merges (the faces of a convex solid usually end as one polygon,
     // its silhouette's).
     // DESIGN: the convexity test's tolerance, 1e-9 of the hull's area, only absorbs rounding.
-    struct Box {
-        Vec2 lo{HUGE_VAL, HUGE_VAL}, hi{-HUGE_VAL, -HUGE_VAL};
-    };
-    auto box_of = [](const ConvexPolygon& s) {
-        Box b;
-        for (const Vec2& q : s) {
-            b.lo = {std::min(b.lo.x, q.x), std::min(b.lo.y, q.y)};
-            b.hi = {std::max(b.hi.x, q.x), std::max(b.hi.y, q.y)};
-        }
-        return b;
-    };
-    std::vector<Box> boxes;
-    for (const ConvexPolygon& s : shadows) boxes.push_back(box_of(s));
+    std::vector<Rect> boxes;
+    for (const ConvexPolygon& s : shadows) boxes.push_back(bounding_rect(s));
     for (bool merged = true; merged;) {
         merged = false;
         for (size_t i = 0; i < shadows.size(); ++i)
             for (size_t j = i + 1; j < shadows.size(); ++j) {
                 // Shadows whose boxes do not even touch cannot have a convex union.
-                const Box& a = boxes[i];
-                const Box& b = boxes[j];
-                if (a.hi.x < b.lo.x || b.hi.x < a.lo.x || a.hi.y < b.lo.y || b.hi.y < a.lo.y) continue;
+                const Rect& a = boxes[i];
+                const Rect& b = boxes[j];
+                if (a.x1 < b.x0 || b.x1 < a.x0 || a.y1 < b.y0 || b.y1 < a.y0) continue;
                 // Overlapping, nested or only touching along an edge (two faces of one solid):
                 // the hull is the union exactly when the union is convex.
                 ConvexPolygon u = convex_union(shadows[i], shadows[j]);
                 if (u.empty()) continue;
                 shadows[i] = std::move(u);
-                boxes[i] = box_of(shadows[i]);
+                boxes[i] = bounding_rect(shadows[i]);
                 shadows.erase(shadows.begin() + long(j));
                 boxes.erase(boxes.begin() + long(j));
                 merged = true;

@@ -90,6 +90,7 @@ struct ShooterPlane {
     Vec3 origin, e1, e2, normal;  // orthonormal frame; normal is the shooter's front
     Vec2 corner[4];               // corners at (u,v) = (0,0), (1,0), (1,1), (0,1)
     ConvexPolygon outline;        // the same, counter-clockwise
+    double size = 0;              // the square root of its area: the scale of its tolerances
     Vec2 to_plane(Vec3 x) const { return {dot(x - origin, e1), dot(x - origin, e2)}; }
     Vec3 to_space(Vec2 q) const { return origin + q.x * e1 + q.y * e2; }
     /// The point of the bilinear map at (u, v), in the frame.
