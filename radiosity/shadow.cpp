@@ -315,15 +315,17 @@ std::vector<int> occluders_toward(const OcclusionContext& context, const Shooter
         out.erase(std::unique(out.begin(), out.end()), out.end());
     };
     std::vector<int> listed;
+    auto keep_listed = [&] {  // the listed candidates that meet the pyramid
+        for (int id : listed)
+            if (std::binary_search(context.candidates.begin(), context.candidates.end(), id) &&
+                !outside_polygon(id))
+                out.push_back(id);
+        listed.clear();
+    };
     context.octree->append_polygons_near(
         [&](const Box3& b) {
             if (enough) return false;
-            for (int id : listed)
-                if (std::binary_search(context.candidates.begin(), context.candidates.end(),
-                                       id) &&
-                    !outside_polygon(id))
-                    out.push_back(id);
-            listed.clear();
+            keep_listed();
             if (limit != SIZE_MAX && out.size() > 2 * limit) {
                 compact();
                 enough = out.size() > limit;
@@ -332,13 +334,29 @@ std::vector<int> occluders_toward(const OcclusionContext& context, const Shooter
             return !outside_box(b);
         },
         listed);
-    for (int id : listed)
-        if (std::binary_search(context.candidates.begin(), context.candidates.end(), id) &&
-            !outside_polygon(id))
-            out.push_back(id);
+    keep_listed();
     compact();
     return out;
 }
+
+namespace {
+
+/// How many of the points lie in front of the view's horizon line and how many behind it;
+/// points within BlockedView::front_tolerance of the line lie on it and count as neither.
+struct HorizonSides {
+    int front = 0, behind = 0;
+};
+HorizonSides horizon_sides(const BlockedView& view, const Vec2* points, size_t n) {
+    HorizonSides sides;
+    for (size_t i = 0; i < n; ++i) {
+        const double v = view.front.value(points[i]);
+        if (v > view.front_tolerance) ++sides.front;
+        if (v < -view.front_tolerance) ++sides.behind;
+    }
+    return sides;
+}
+
+}  // namespace
 
 BlockedView blocked_view(const ShooterPlane& plane, Vec3 p, Vec3 n_p,
                          const OcclusionContext* context, const Plane* receiver_plane) {
@@ -358,23 +376,18 @@ BlockedView blocked_view(const ShooterPlane& plane, Vec3 p, Vec3 n_p,
     // (triangles or the tensor rule) differ by the quadrature's error, so that one scene in two
     // units differed by it. (Not a fraction of the shooter's size alone: a shooter 1e9 times
     // its distance from the receiver has its corners 1e-9 of its size in front.)
-    const double size = plane.size;
-    const double magnitude =
-        size + (receiver_plane ? std::fabs(dot(receiver_plane->normal, plane.origin)) +
-                                     std::fabs(receiver_plane->offset)
-                               : std::fabs(dot(n_p, plane.origin)) + std::fabs(dot(n_p, p)));
+    const double distances = receiver_plane
+                                 ? std::fabs(dot(receiver_plane->normal, plane.origin)) +
+                                       std::fabs(receiver_plane->offset)
+                                 : std::fabs(dot(n_p, plane.origin)) + std::fabs(dot(n_p, p));
+    const double magnitude = plane.size + distances;
     view.front_tolerance = 1e-12 * magnitude;
-    int n_front = 0, n_behind = 0;
-    for (const Vec2& q : plane.corner) {
-        const double v = view.front.value(q);
-        if (v > view.front_tolerance) ++n_front;
-        if (v < -view.front_tolerance) ++n_behind;
-    }
-    if (n_front == 0) {
+    const HorizonSides corners = horizon_sides(view, plane.corner, 4);
+    if (corners.front == 0) {
         view.behind_all = true;
         return view;
     }
-    view.horizon_cuts = n_behind > 0;
+    view.horizon_cuts = corners.behind > 0;
 
     const double h_p = dot(plane.normal, p - plane.origin);  // height of p above the plane
     if (!context || context->candidates.empty() || h_p <= 0) return view;
@@ -443,7 +456,7 @@ BlockedView blocked_view(const ShooterPlane& plane, Vec3 p, Vec3 n_p,
         // edge lines pointing anywhere (see below). Its width, not its area against the
         // shooter's: seen from a point close to a large shooter, a shadow small beside the
         // shooter can hide most of what the point sees.
-        if (!is_sliver(shadow, 1e-10 * size, 1e-7 * size))
+        if (!is_sliver(shadow, 1e-10 * plane.size, 1e-7 * plane.size))
             view.shadows.push_back(std::move(shadow));
     }
     merge_shadows(view.shadows);
@@ -452,7 +465,7 @@ BlockedView blocked_view(const ShooterPlane& plane, Vec3 p, Vec3 n_p,
     // hulls of merged faces leave such vertices where rounding decides, and an edge between
     // two nearly equal vertices has a line pointing anywhere, along which the shadow stage
     // would cut (subtract, classify).
-    for (ConvexPolygon& shadow : view.shadows) remove_flat_vertices(shadow, 1e-10 * size);
+    for (ConvexPolygon& shadow : view.shadows) remove_flat_vertices(shadow, 1e-10 * plane.size);
     return view;
 }
 
@@ -493,14 +506,9 @@ CellVisibility classify_cell(const ConvexPolygon& cell, const BlockedView& view,
     if (view.behind_all) return CellVisibility::hidden;
     bool cut = false;
     if (view.horizon_cuts) {
-        int n_front = 0, n_behind = 0;
-        for (const Vec2& q : cell) {
-            const double v = view.front.value(q);
-            if (v > view.front_tolerance) ++n_front;
-            if (v < -view.front_tolerance) ++n_behind;
-        }
-        if (n_front == 0) return CellVisibility::hidden;
-        cut = n_behind > 0;
+        const HorizonSides sides = horizon_sides(view, cell.data(), cell.size());
+        if (sides.front == 0) return CellVisibility::hidden;
+        cut = sides.behind > 0;
     }
     for (const ConvexPolygon& s : view.shadows) {
         const Overlap o = classify(cell, s);
