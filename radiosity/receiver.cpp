@@ -252,10 +252,9 @@ void subdivide_by_oracle(ReceiverState& state, IncrementSampler& sampler) {
 
     // The shooter's plane when it is planar (the contact rule of ReceiverOptions::contact_depth
     // and contact_oracle_test).
-    const bool contact_rule =
-        opt.contact_depth > 0 || opt.contact_oracle_test != opt.oracle_test;
+    const bool contact_test = opt.contact_oracle_test != opt.oracle_test;
     const ShooterPlane* contact_plane =
-        contact_rule ? sampler.integrator(0).shooter_plane() : nullptr;
+        opt.contact_depth > 0 || contact_test ? sampler.integrator(0).shooter_plane() : nullptr;
 
     enum Action { Leaf, Split, SplitOnceMore };
     std::vector<int> frontier{forest.domain_root()};
@@ -271,8 +270,7 @@ void subdivide_by_oracle(ReceiverState& state, IncrementSampler& sampler) {
             }
             // Whether the cell touches the shooter, asked only when an answer matters.
             const bool ask = contact_plane && (cell.level < opt.contact_depth ||
-                                               (opt.contact_oracle_test != opt.oracle_test &&
-                                                cell.level < opt.max_depth));
+                                               (contact_test && cell.level < opt.max_depth));
             const bool contact =
                 ask && touches_shooter(*sampler.receiver().surface, *contact_plane, cell.rect());
             if (cell.level < opt.contact_depth && contact) {
