@@ -1,5 +1,5 @@
 // test/fuzz_mutate.h - the seeded mutations shared by the scene-reader tests
-// (test/test_scene_fuzz.cpp) and the long-running fuzz driver (test/fuzz_readers.cpp, issue 11):
+// (test/test_scene_fuzz.cpp) and the long-running fuzz driver (test/fuzz_readers.cpp):
 // byte flips, insertions of bytes and reader tokens, deletions, duplicated and swapped lines,
 // numbers replaced by huge, tiny, NaN or negative values, truncation.
 #pragma once

@@ -1,4 +1,4 @@
-// test/fuzz_readers.cpp - the long-running fuzz driver of issue 11 for every reader of outside
+// test/fuzz_readers.cpp - the long-running fuzz driver for every reader of outside
 // data: scene files, OBJ, MTL and solution files (docs/fuzzing.md). g++ has no libFuzzer, so this
 // is a deterministic mutation loop: seed corpora, seeded mutations (test/fuzz_mutate.h plus
 // extreme numbers), each input written to a file and read the way the programs read it. The
@@ -27,9 +27,9 @@
 
 #include "math/check.h"
 #include "octree/octree.h"
-#include "radiosity/scene_io.h"
-#include "radiosity/scene_octree.h"
-#include "radiosity/solver.h"
+#include "radiosity/scene/scene_io.h"
+#include "radiosity/scene/scene_octree.h"
+#include "radiosity/solver/solver.h"
 #include "test/file_bytes.h"
 #include "test/fuzz_mutate.h"
 

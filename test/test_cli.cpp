@@ -19,7 +19,7 @@
 
 #include "examples/common/cli.h"
 #include "examples/common/transfer_cli.h"
-#include "radiosity/output_file.h"
+#include "radiosity/output/output_file.h"
 
 using namespace mbr;
 

@@ -1,5 +1,5 @@
-// test/test_cost.cpp - bounded cost, said before it is spent (issue 11): the memory estimate of
-// radiosity/cost.h grows with every setting and refuses a run over the budget; an image named by
+// test/test_cost.cpp - bounded cost, said before it is spent: the memory estimate of
+// radiosity/solver/cost.h grows with every setting and refuses a run over the budget; an image named by
 // several materials is counted (and decoded) once; a failure inside a parallel loop reaches the
 // caller as an exception; coarsening a deep shooter by every number of levels works.
 #include <algorithm>
@@ -12,10 +12,10 @@
 #include "examples/common/transfer_cli.h"
 #include "math/check.h"
 #include "math/parallel.h"
-#include "radiosity/cost.h"
-#include "radiosity/receiver.h"
-#include "radiosity/scene_io.h"
-#include "radiosity/solver.h"
+#include "radiosity/solver/cost.h"
+#include "radiosity/transfer/receiver.h"
+#include "radiosity/scene/scene_io.h"
+#include "radiosity/solver/solver.h"
 
 using namespace mbr;
 

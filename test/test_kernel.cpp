@@ -1,7 +1,7 @@
 // test/test_kernel.cpp - the kernel F of eq. (3), the analytic point-to-polygon form factor that
 // is the exact reference of Tables 1-2 (section 7, "an analytic formula advocated in [7]"), and
 // the adaptive quadrature of the sample value (21) over the shooter (section 6, "Adaptive
-// Quadrature"; radiosity/kernel.h).
+// Quadrature"; radiosity/transfer/sample_values.h).
 //
 // Independent references:
 // - closed forms of the form factor from a differential area to a rectangle (Siegel and Howell,
@@ -22,8 +22,8 @@
 #include <vector>
 
 #include "math/gauss_legendre.h"
-#include "radiosity/kernel.h"
-#include "radiosity/reference.h"
+#include "radiosity/transfer/sample_values.h"
+#include "radiosity/reference/configurations.h"
 #include "test/report.h"
 
 using namespace mbr;

@@ -1,5 +1,5 @@
-// test/test_mbr_tool.cpp - the mbr command-line tool (examples/mbr.cpp) end to end, run as a
-// child process (issue 9): `mbr render` writes a PNG of the camera's size and nothing else, a
+// test/test_mbr_tool.cpp - the mbr command-line tool (examples/mbr/mbr.cpp) end to end, run as a
+// child process: `mbr render` writes a PNG of the camera's size and nothing else, a
 // missing output folder is status 1 with no file left, bad arguments and bad input are status 2
 // with one stderr line naming the problem, a saved solution loads back to the same image, `mbr
 // probe` prints B at points in their order (the emission on a light, zero on a black surface and
@@ -97,7 +97,7 @@ size_t count_lines(const std::string& s) {
     return size_t(std::count(s.begin(), s.end(), '\n'));
 }
 
-// One complete line: the tool's promise for every error (examples/mbr.cpp, STYLE.md B7).
+// One complete line: the tool's promise for every error (examples/mbr/mbr.cpp, STYLE.md B7).
 bool is_one_line(const std::string& s) {
     return count_lines(s) == 1 && s.back() == '\n';
 }
@@ -326,7 +326,7 @@ TEST_CASE("mbr_tool: probe prints B at the points in order: E, zero and rho E F"
     CHECK(count_lines(run.out) == lines.size());  // every row ends with its newline
 
     // The solver's accuracy target: tolerance 1e-3 (the default) times the scene's radiosity
-    // scale, its largest emitted power over the total area (radiosity/solver.h), as an absolute
+    // scale, its largest emitted power over the total area (radiosity/solver/solver.h), as an absolute
     // error of each transfer; exactly one transfer (light to floor) reaches the floor. That is
     // 2.5e-3 here, about 1% of the values; the errors are at most 5.2e-4 (MBR_TEST_REPORT=1
     // prints them), and a wrong rho, E, channel order or a mirrored or transposed floor would

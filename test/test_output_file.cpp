@@ -1,4 +1,4 @@
-// test/test_output_file.cpp - radiosity/output_file.h: a file is replaced only by a complete
+// test/test_output_file.cpp - radiosity/output/output_file.h: a file is replaced only by a complete
 // write; symbolic links, devices, FIFOs and stdout are written as what they are; directories,
 // missing and read-only folders and full disks are refused with the system's reason, leaving no
 // temporary file and the old content intact. The read-only folder and the full disk need a small
@@ -24,8 +24,8 @@
 #include <string>
 #include <thread>
 
-#include "radiosity/image.h"
-#include "radiosity/output_file.h"
+#include "radiosity/output/image.h"
+#include "radiosity/output/output_file.h"
 #include "test/file_bytes.h"
 
 using namespace mbr;

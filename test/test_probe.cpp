@@ -1,4 +1,4 @@
-// test/test_probe.cpp - probe points (radiosity/probe.h): world points on every surface kind are
+// test/test_probe.cpp - probe points (radiosity/reference/probe.h): world points on every surface kind are
 // located at the (u, v) that maps to them, a normal decides between surfaces that meet, a point
 // far from every surface is refused by name, each malformed CSV gets an InputError at its line,
 // and results are written with the exact headers.
@@ -10,8 +10,8 @@
 #include <vector>
 
 #include "math/check.h"
-#include "radiosity/probe.h"
-#include "radiosity/scene_octree.h"
+#include "radiosity/reference/probe.h"
+#include "radiosity/scene/scene_octree.h"
 
 using namespace mbr;
 using Catch::Matchers::Contains;

@@ -1,6 +1,6 @@
 // test/test_receiver.cpp - one energy transfer, stage by stage (paper section 5, "Energy Transfer
 // between a Pair of Surfaces"; section 6's extrapolation, projection and scale adjustment;
-// radiosity/receiver.h), and the paper's Tables 1 and 2 (section 7).
+// radiosity/transfer/receiver.h), and the paper's Tables 1 and 2 (section 7).
 //
 // Most tests drive the stages by hand: a forest built to order, the expanded ring as
 // expand_domain builds it (an expanded cell touching a boundary leaf has that leaf's size), and
@@ -24,8 +24,8 @@
 #include "math/bspline.h"
 #include "math/dual_basis.h"
 #include "math/gauss_legendre.h"
-#include "radiosity/receiver.h"
-#include "radiosity/reference.h"
+#include "radiosity/transfer/receiver.h"
+#include "radiosity/reference/configurations.h"
 #include "test/report.h"
 
 #ifdef _OPENMP

@@ -1,4 +1,4 @@
-// test/test_render.cpp - the renderer (radiosity/render.h): radiance B / pi of the solved fields
+// test/test_render.cpp - the renderer (radiosity/output/render.h): radiance B / pi of the solved fields
 // (eq. (20)) seen by the camera, one-sided surfaces, jitter that depends on the seed and not on
 // the threads, sRGB tone mapping, Radiance RGBE files and the quadtree overlay.
 //
@@ -17,10 +17,10 @@
 #include <vector>
 
 #include "math/check.h"
-#include "radiosity/render.h"
-#include "radiosity/scene_io.h"
-#include "radiosity/scene_octree.h"
-#include "radiosity/texture.h"
+#include "radiosity/output/render.h"
+#include "radiosity/scene/scene_io.h"
+#include "radiosity/scene/scene_octree.h"
+#include "radiosity/geometry/texture.h"
 #include "test/report.h"
 
 #ifdef _OPENMP

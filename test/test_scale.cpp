@@ -1,8 +1,8 @@
-// test/test_scale.cpp - scale invariance and extreme relative sizes (issue 11, "Scale and
+// test/test_scale.cpp - scale invariance and extreme relative sizes ("scale and
 // relative size"): the transfers of Tables 1 and 2 (paper section 7) give the same rea of
 // eq. (29) whatever unit the scene is given in, and a shooter far smaller than its receiver is
 // measured as accurately as a small one, with the analytic point-to-polygon form factor
-// (radiosity/kernel.h) exact to rounding for a polygon far smaller than its distance.
+// (radiosity/transfer/sample_values.h) exact to rounding for a polygon far smaller than its distance.
 //
 // Independent reference for the tiny polygon: the point-source limit of the form factor,
 // F = A cos(theta_p) cos(theta_x) / (pi r^2) with r from p to the polygon's centroid, whose
@@ -18,13 +18,13 @@
 #include <vector>
 
 #include "examples/common/transfer_cli.h"
-#include "radiosity/hidden.h"
-#include "radiosity/kernel.h"
-#include "radiosity/receiver.h"
-#include "radiosity/scene_io.h"
-#include "radiosity/scene_octree.h"
-#include "radiosity/shadow.h"
-#include "radiosity/solver.h"
+#include "radiosity/visibility/hidden_regions.h"
+#include "radiosity/transfer/sample_values.h"
+#include "radiosity/transfer/receiver.h"
+#include "radiosity/scene/scene_io.h"
+#include "radiosity/scene/scene_octree.h"
+#include "radiosity/visibility/visible_parts.h"
+#include "radiosity/solver/solver.h"
 #include "test/report.h"
 
 using namespace mbr;
@@ -49,7 +49,7 @@ std::vector<Vec3> tilted_square(double s) {
     return {at(0, 0), at(1, 0), at(1, 1), at(0, 1)};
 }
 
-/// The unit square in z = 0, facing up: the receiver of issue 11's sweep of shooter sizes.
+/// The unit square in z = 0, facing up: the receiver of the sweep of shooter sizes.
 Surface unit_receiver() {
     return Surface::planar_quad({0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0});
 }
@@ -98,7 +98,7 @@ TEST_CASE("scale: Table 2 transfer (d = 2) gives the same rea in any unit", "[sc
 
 TEST_CASE("scale: a shooter 1e-8 the size of its receiver keeps the rea of one 0.1 its size",
           "[scale]") {
-    // Issue 11: a square shooter of side s at the corner of the unit square, distance 1,
+    // The sweep: a square shooter of side s at the corner of the unit square, distance 1,
     // receiver depth 3: s = 1e-8 gave rea 66 % against 0.039 % at s = 0.1 (the contour
     // formula's cross products). The tilted square away from the origin also needs the
     // shooter's plane to keep its digits: its Newell normal summed over absolute corners gave
@@ -123,7 +123,7 @@ TEST_CASE("scale: a shooter 1e-8 the size of its receiver keeps the rea of one 0
 
 TEST_CASE("scale: a shooter 1e9 the size of its distance keeps the rea of one 1e6 its size",
           "[scale]") {
-    // Issue 11's sweep at the large end: the square of side s from the corner of the unit
+    // The sweep at the large end: the square of side s from the corner of the unit
     // square at distance 1 (single_transfer --shooter 0 0 1 0 s 1 s s 1 s 0 1 --receiver
     // 0 0 0 1 0 0 1 1 0 0 1 0 --depth 3). Side 1e9 once gave rea 27.6 % against 0.0029 % at
     // 1e6 (absolute tolerances); later 100 %, when the horizon's tolerance was 1e-9 of the
@@ -163,8 +163,8 @@ TEST_CASE("scale: the form factor of a tiny polygon tends to the point-source li
                             << worst << " from the point-source limit\n";
         // The limit is exact to (s / r)^2 <= 1e-8 here; rounding leaves about eps r / s <= 2e-7
         // (at s = 1e-9) in the contour sum, whose terms of order s / r cancel down to F. 1e-5
-        // is well above both; the form of the cross products before issue 11 erred by about
-        // eps (r / s)^2: 4e-5 at s = 1e-6 and all of F at 1e-8.
+        // is well above both; the earlier form of the cross products (over absolute positions)
+        // erred by about eps (r / s)^2: 4e-5 at s = 1e-6 and all of F at 1e-8.
         REQUIRE(worst < 1e-5);
     }
 }
@@ -186,7 +186,7 @@ ShadowSetup scaled(const ShadowSetup& setup, double k) {
     return out;
 }
 
-/// The shadowed transfer of examples/shadow_transfer.cpp (`measure`): shooter radiosity 1,
+/// The shadowed transfer of examples/studies/shadow_transfer.cpp (`measure`): shooter radiosity 1,
 /// reflectance 1, uniform depth d, its field on an n x n grid.
 std::vector<double> shadowed_values(const ShadowSetup& setup, ShadowMethod method, int d, int n) {
     std::vector<Polygon> polygons;

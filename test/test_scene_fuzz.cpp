@@ -1,4 +1,4 @@
-// test/test_scene_fuzz.cpp - the scene and OBJ/MTL readers never crash or hang (issue 3): thousands
+// test/test_scene_fuzz.cpp - the scene and OBJ/MTL readers never crash or hang: thousands
 // of randomly mutated inputs (byte flips, insertions, deletions, duplicated and swapped lines,
 // numbers replaced by huge, tiny, NaN or negative values, truncation), seeded and reproducible.
 // Every outcome must be a valid Scene or an InputError; anything else, or one input taking
@@ -16,8 +16,8 @@
 #include <sstream>
 
 #include "math/check.h"
-#include "radiosity/scene_io.h"
-#include "radiosity/solver.h"
+#include "radiosity/scene/scene_io.h"
+#include "radiosity/solver/solver.h"
 #include "test/file_bytes.h"
 #include "test/fuzz_mutate.h"
 
@@ -188,7 +188,7 @@ TEST_CASE("scene_fuzz: mutated MTL files give a Scene or an InputError", "[scene
 
 TEST_CASE("scene_fuzz: a solution header naming a huge field is refused before allocating it",
           "[scene_fuzz][solution]") {
-    // Found by mbr_fuzz_readers (issue 11; test/data/fuzz_finds/): 'radiosity level 14' at
+    // Found by mbr_fuzz_readers (test/data/fuzz_finds/): 'radiosity level 14' at
     // order 8 made load_solution allocate 3 x 2.7e8 coefficients (6 GiB) before it read the
     // coefficient line that could never hold them. The reproducer is saved for
     // examples/scenes/parallel_squares.scene, whose fingerprint it carries.

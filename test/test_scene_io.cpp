@@ -1,4 +1,4 @@
-// test/test_scene_io.cpp - the scene format and OBJ/MTL import of radiosity/scene_io.h: every
+// test/test_scene_io.cpp - the scene format and OBJ/MTL import of radiosity/scene/scene_io.h: every
 // example scene loads with the expected counts and orientations, each class of bad input gets
 // its message at the right line, and OBJ faces become the quads docs/scene-format.md promises.
 #include <unistd.h>
@@ -11,8 +11,8 @@
 #include <sstream>
 
 #include "math/check.h"
-#include "radiosity/scene_io.h"
-#include "radiosity/solver.h"
+#include "radiosity/scene/scene_io.h"
+#include "radiosity/solver/solver.h"
 
 using namespace mbr;
 using Catch::Matchers::Contains;

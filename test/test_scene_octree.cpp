@@ -1,5 +1,5 @@
 // test/test_scene_octree.cpp - the glue from scenes to the paper's octree (section 6, "Octree";
-// radiosity/scene_octree.h): every example scene's surfaces become polygons that cover them,
+// radiosity/scene/scene_octree.h): every example scene's surfaces become polygons that cover them,
 // octree answers equal brute force over those polygons, a hit's surface id and (u, v) map back
 // to the point the ray hit, the camera of the Cornell box sees the box, and facets the Polygon
 // constructor refuses are split or dropped, never fatal.
@@ -13,8 +13,8 @@
 #include <vector>
 
 #include "octree/octree.h"
-#include "radiosity/scene_io.h"
-#include "radiosity/scene_octree.h"
+#include "radiosity/scene/scene_io.h"
+#include "radiosity/scene/scene_octree.h"
 #include "test/report.h"
 
 using namespace mbr;

@@ -7,7 +7,7 @@
 // (IncrementIntegrator with an OcclusionContext, horizon clipping) against the analytic
 // shadowed form factor, itself checked against an adaptive brute force.
 //
-// Configurations are those of examples/shadow_transfer.cpp: parallel unit squares at h = 1 (the
+// Configurations are those of examples/studies/shadow_transfer.cpp: parallel unit squares at h = 1 (the
 // receiver [0,1]^2 in z = 0 facing up, the shooter in z = 1 facing down) and an opaque occluder
 // between them, in an octree with the shooter as surface 0, the receiver as 1, occluders 2, 3...
 #include <algorithm>
@@ -22,10 +22,10 @@
 
 #include "math/bspline.h"
 #include "math/gauss_legendre.h"
-#include "radiosity/kernel.h"
-#include "radiosity/receiver.h"
-#include "radiosity/reference.h"
-#include "radiosity/shadow.h"
+#include "radiosity/transfer/sample_values.h"
+#include "radiosity/transfer/receiver.h"
+#include "radiosity/reference/configurations.h"
+#include "radiosity/visibility/visible_parts.h"
 #include "test/report.h"
 
 #ifdef _OPENMP
@@ -47,7 +47,7 @@ Polygon make_polygon(const std::vector<Vec3>& v, int surface) {
     return Polygon(v, std::vector<Vec2>(v.size()), surface);
 }
 
-/// The octree of examples/shadow_transfer.cpp: shooter 0, receiver 1, occluder k as 2 + k.
+/// The octree of examples/studies/shadow_transfer.cpp: shooter 0, receiver 1, occluder k as 2 + k.
 Octree make_octree(const ShadowSetup& setup) {
     std::vector<Polygon> polygons;
     polygons.push_back(make_polygon(quad_polygon(setup.shooter), 0));
@@ -1083,7 +1083,7 @@ TEST_CASE("shadow: exact visibility on a curved shooter casts rays and matches t
 
 TEST_CASE("shadow: exact visibility on a curved shooter sees a shadow along a cell's edge",
           "[shadow][!mayfail]") {
-    // KNOWN LIMITATION (radiosity/kernel.cpp, IncrementIntegrator::cell_value, curved path): a
+    // KNOWN LIMITATION (radiosity/transfer/sample_values.cpp, IncrementIntegrator::cell_value, curved path): a
     // cell is split for visibility only when its quadrature nodes disagree; a shadow that covers
     // only a sliver between the cell's edge and its outermost nodes (up to ~3 % of the cell's
     // width for n = 6) is never seen. Input: the tilted configuration (occluded_squares(30)) with

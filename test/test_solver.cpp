@@ -1,8 +1,8 @@
 // test/test_solver.cpp - the progressive loop over whole scenes (paper section 4;
-// radiosity/solver.h) and its solution files (docs/solution-format.md).
+// radiosity/solver/solver.h) and its solution files (docs/solution-format.md).
 //
 // Independent references: the power balance of a closed box (everything a shooter sends arrives
-// on some face), the single transfer of radiosity/receiver.h run by hand with the options the
+// on some face), the single transfer of radiosity/transfer/receiver.h run by hand with the options the
 // loop gives it, and the analytic point-to-polygon form factor for a first bounce. The scenes
 // are small and the depths low, so that every test runs in about a second.
 #include <catch2/catch.hpp>
@@ -12,13 +12,13 @@
 #include <vector>
 
 #include "math/check.h"
-#include "radiosity/hidden.h"
-#include "radiosity/kernel.h"
-#include "radiosity/receiver.h"
-#include "radiosity/scene_io.h"
-#include "radiosity/scene_octree.h"
-#include "radiosity/shadow.h"
-#include "radiosity/solver.h"
+#include "radiosity/visibility/hidden_regions.h"
+#include "radiosity/transfer/sample_values.h"
+#include "radiosity/transfer/receiver.h"
+#include "radiosity/scene/scene_io.h"
+#include "radiosity/scene/scene_octree.h"
+#include "radiosity/visibility/visible_parts.h"
+#include "radiosity/solver/solver.h"
 #include "test/report.h"
 
 #ifdef _OPENMP
@@ -190,7 +190,7 @@ TEST_CASE("solver: radiosity is never negative or NaN", "[solver]") {
 
 // Known defect, kept visible: [!shouldfail] passes while the check fails; when the solver is
 // fixed, this test fails and the tag must go. A block resting on the floor hides a square of it;
-// the hidden region's samples take the nearest visible values (radiosity/hidden.h), which are
+// the hidden region's samples take the nearest visible values (radiosity/visibility/hidden_regions.h), which are
 // nearly zero in the block's contact shadow, and the floor's spline dips to -0.0044 there
 // (against a largest 0.16, measured on this 65 x 65 grid). The points are hidden (nobody sees
 // them), but the field's power integral includes them. (The Cornell box also dips below zero

@@ -1,6 +1,6 @@
 // test/test_spline_field.cpp - a surface's radiosity as tensor B-spline coefficients at one scale
 // (paper sections 4-5: eq. (20) reconstruction, (17) refinement, "Scale Unification and
-// Superposition"; section 6's coarsened shooter, eq. (11); radiosity/spline_field.h).
+// Superposition"; section 6's coarsened shooter, eq. (11); radiosity/geometry/spline_field.h).
 //
 // Independent references: the defining sum (20) with math's bspline() one basis function at a
 // time, Gauss-Legendre integrals on the knot cells (exact: every integrand is a polynomial of
@@ -12,7 +12,7 @@
 
 #include "math/bspline.h"
 #include "math/gauss_legendre.h"
-#include "radiosity/spline_field.h"
+#include "radiosity/geometry/spline_field.h"
 #include "test/report.h"
 
 using namespace mbr;

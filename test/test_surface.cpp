@@ -1,4 +1,4 @@
-// test/test_surface.cpp - the parametric surfaces of radiosity/surface.h (paper section 2,
+// test/test_surface.cpp - the parametric surfaces of radiosity/geometry/surface.h (paper section 2,
 // eq. (4)): the area factor integrates to each kind's closed-form area, tangents agree with
 // finite differences of x(u,v), normals are unit and equal to x_u x x_v normalised, and
 // tessellation facets are planar, lie on (or, for curved kinds, near) the surface and cover it.
@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "math/gauss_legendre.h"
-#include "radiosity/surface.h"
+#include "radiosity/geometry/surface.h"
 
 using namespace mbr;
 

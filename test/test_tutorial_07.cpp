@@ -1,4 +1,4 @@
-// test/test_tutorial_07.cpp - tutorial chapter 7 (examples/tutorial_07_shadows.cpp,
+// test/test_tutorial_07.cpp - tutorial chapter 7 (examples/tutorial/tutorial_07_shadows.cpp,
 // docs/tutorial/07-shadows.md) run small: shadow depths 2 and 3 on a 64 x 64 error grid. The
 // chapter's story must hold (rea of the paper's fractions (28) falls with the shadow depth while
 // the rays grow; visibility inside (21) beats both), and its key numbers must stay what the

@@ -1,4 +1,4 @@
-// test/test_tutorial_09.cpp - tutorial chapter 9 (examples/tutorial_09_rendering.cpp,
+// test/test_tutorial_09.cpp - tutorial chapter 9 (examples/tutorial/tutorial_09_rendering.cpp,
 // docs/tutorial/09-rendering.md) run small: receiver depth 3, ten shots, a 64 x 64 render with
 // one sample per pixel.
 // Checked: the render and the comparison image are written, all 16 reference points are read

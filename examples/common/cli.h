@@ -2,7 +2,7 @@
 // rejects what it does not understand, a table that prints as aligned text or CSV, and the
 // main() wrapper that turns exceptions into one stderr line and an exit code (STYLE.md B7):
 // 0 on success, 2 for a bad command line or bad input (UsageError, InputError), 1 for a failure
-// while running (OutputError from radiosity/output_file.h and anything else), including a
+// while running (OutputError from radiosity/output/output_file.h and anything else), including a
 // failure to write the report or CSV on stdout.
 #pragma once
 
@@ -71,7 +71,7 @@ double parse_memory_size(const std::string& text, const std::string& what);
 struct CostEstimate;
 /// Usage line of --memory-budget.
 extern const char* memory_budget_usage;
-/// "--memory-budget X" (parse_memory_size), default default_memory_budget() (radiosity/cost.h).
+/// "--memory-budget X" (parse_memory_size), default default_memory_budget() (radiosity/solver/cost.h).
 double read_memory_budget(Args& args);
 /// Says the cost before it is spent: UsageError "<run> needs about N, more than the memory
 /// budget B ..." when cost.bytes exceeds the budget; otherwise, when `slow`, one warning line on

@@ -19,7 +19,7 @@
 #include <vector>
 
 #include "math/vec3.h"
-#include "radiosity/image.h"
+#include "radiosity/output/image.h"
 
 namespace mbr {
 

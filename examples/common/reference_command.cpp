@@ -6,10 +6,10 @@
 #include <iostream>
 #include <string>
 
-#include "radiosity/path_tracer.h"
-#include "radiosity/probe.h"
-#include "radiosity/scene_io.h"
-#include "radiosity/scene_octree.h"
+#include "radiosity/reference/path_tracer.h"
+#include "radiosity/reference/probe.h"
+#include "radiosity/scene/scene_io.h"
+#include "radiosity/scene/scene_octree.h"
 
 namespace mbr {
 

@@ -1,6 +1,6 @@
 // examples/common/reference_command.h - `mbr reference`: an independent Monte Carlo estimate of
-// the radiosity B of eq. (1) at user-chosen world points of any scene (radiosity/probe.h,
-// radiosity/path_tracer.h), to check mbr's solution or compare it with other renderers.
+// the radiosity B of eq. (1) at user-chosen world points of any scene (radiosity/reference/probe.h,
+// radiosity/reference/path_tracer.h), to check mbr's solution or compare it with other renderers.
 #pragma once
 
 #include "examples/common/cli.h"

@@ -12,11 +12,11 @@
 
 #include "math/check.h"
 #include "math/parallel.h"
-#include "radiosity/cost.h"
-#include "radiosity/image.h"
-#include "radiosity/output_file.h"
-#include "radiosity/scene_io.h"
-#include "radiosity/scene_octree.h"
+#include "radiosity/solver/cost.h"
+#include "radiosity/output/image.h"
+#include "radiosity/output/output_file.h"
+#include "radiosity/scene/scene_io.h"
+#include "radiosity/scene/scene_octree.h"
 
 #ifdef _OPENMP
 #include <omp.h>

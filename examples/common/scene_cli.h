@@ -10,9 +10,9 @@
 
 #include "examples/common/cli.h"
 #include "octree/octree.h"
-#include "radiosity/render.h"
-#include "radiosity/scene.h"
-#include "radiosity/solver.h"
+#include "radiosity/output/render.h"
+#include "radiosity/scene/scene.h"
+#include "radiosity/solver/solver.h"
 
 namespace mbr {
 
@@ -52,7 +52,7 @@ std::vector<std::string> summary_cells(const SolveStats& stats);
 void write_summary_csv(std::ostream& os, const SolveStats& stats);
 
 /// Renders the solution with the scene's camera (radiance B / pi, sRGB tone mapping with
-/// options.exposure) and writes it as a PNG to `path` (all or nothing, radiosity/output_file.h).
+/// options.exposure) and writes it as a PNG to `path` (all or nothing, radiosity/output/output_file.h).
 /// InputError when the scene has no camera. Returns the render's seconds.
 double write_render(const SceneRun& run, const Solution& solution, const std::string& path,
                     const RenderOptions& options = {});

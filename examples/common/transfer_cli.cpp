@@ -3,7 +3,7 @@
 
 #include <sstream>
 
-#include "radiosity/cost.h"
+#include "radiosity/solver/cost.h"
 
 namespace mbr {
 

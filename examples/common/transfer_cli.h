@@ -5,8 +5,8 @@
 #include <string>
 
 #include "examples/common/cli.h"
-#include "radiosity/receiver.h"
-#include "radiosity/reference.h"
+#include "radiosity/transfer/receiver.h"
+#include "radiosity/reference/configurations.h"
 
 namespace mbr {
 
@@ -24,7 +24,7 @@ ReceiverOptions read_receiver_options(Args& args);
 /// ignoring them ("--depth has no effect with --adaptive"). Returns base with min_depth,
 /// max_depth and oracle_tolerance set. Also reads --memory-budget (memory_budget_usage) and
 /// refuses, before anything is allocated, a tree whose estimated memory exceeds it
-/// (radiosity/cost.h); a depth of slow_receiver_depth or more prints one warning on stderr.
+/// (radiosity/solver/cost.h); a depth of slow_receiver_depth or more prints one warning on stderr.
 ReceiverOptions read_tree_options(Args& args, ReceiverOptions base);
 
 /// True when the fronts of two planar quads face each other somewhere: some corner of each lies

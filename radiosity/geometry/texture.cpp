@@ -1,0 +1,234 @@
+// radiosity/geometry/texture.cpp - constant, checker and image fields over [0,1]^2 (texture.h).
+#include "radiosity/geometry/texture.h"
+
+#include <stb_image.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+
+#include "math/check.h"
+
+namespace mbr {
+
+namespace {
+
+Rgb channel_min(Rgb a, Rgb b) {
+    return {std::min(a.r, b.r), std::min(a.g, b.g), std::min(a.b, b.b)};
+}
+Rgb channel_max(Rgb a, Rgb b) {
+    return {std::max(a.r, b.r), std::max(a.g, b.g), std::max(a.b, b.b)};
+}
+
+/// Clamps to [0,1]; NaN becomes 0 so that a bad argument can never index outside the texels.
+double clamp01(double x) {
+    return x >= 0 ? (x <= 1 ? x : 1.0) : 0.0;
+}
+
+}  // namespace
+
+double srgb_to_linear(double c) {
+    // IEC 61966-2-1: a linear toe below 0.04045, a 2.4 power above.
+    return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4);
+}
+
+Texture Texture::constant(Rgb value) {
+    Texture t;
+    t.kind_ = Kind::Constant;
+    t.a_ = value;
+    return t;
+}
+
+Texture Texture::checker(Rgb a, Rgb b, int n) {
+    MBR_CHECK_MSG(n >= 1, "checker squares n = " << n);
+    Texture t;
+    t.kind_ = Kind::Checker;
+    t.a_ = a;
+    t.b_ = b;
+    t.n_ = n;
+    return t;
+}
+
+Rgb Texture::Pixels::texel(int x, int y) const {
+    const size_t i = size_t(y) * size_t(width) + size_t(x);
+    if (!srgb) return linear[i];
+    const unsigned char* c = srgb.get() + 3 * i;
+    return {decoded[c[0]], decoded[c[1]], decoded[c[2]]};
+}
+
+Texture Texture::from_shared(std::shared_ptr<const Pixels> pixels, Rgb scale,
+                             const std::string& name) {
+    Texture t;
+    t.kind_ = Kind::Image;
+    t.pixels_ = std::move(pixels);
+    t.scale_ = scale;
+    t.source_ = name;
+    return t;
+}
+
+namespace {
+
+/// Fills mean, lo and hi of the unscaled texels.
+template <typename Pixels>
+void summarize(Pixels& p) {
+    Rgb sum, lo{HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi{-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+    for (int y = 0; y < p.height; ++y)
+        for (int x = 0; x < p.width; ++x) {
+            const Rgb texel = p.texel(x, y);
+            sum += texel;
+            lo = channel_min(lo, texel);
+            hi = channel_max(hi, texel);
+        }
+    p.mean = sum * (1.0 / (double(p.width) * double(p.height)));
+    p.lo = lo;
+    p.hi = hi;
+}
+
+}  // namespace
+
+Texture Texture::from_pixels(int width, int height, std::vector<Rgb> linear, Rgb scale,
+                             const std::string& name) {
+    MBR_CHECK(width >= 1 && height >= 1 && linear.size() == size_t(width) * size_t(height));
+    auto pixels = std::make_shared<Pixels>();
+    pixels->width = width;
+    pixels->height = height;
+    pixels->linear = std::move(linear);
+    summarize(*pixels);
+    return from_shared(std::move(pixels), scale, name);
+}
+
+Texture Texture::image(const std::string& path, Rgb scale) {
+    // Ask for the size first, so that an absurd header cannot make stb_image allocate gigabytes.
+    int width = 0, height = 0, channels = 0;
+    if (!stbi_info(path.c_str(), &width, &height, &channels)) {
+        errno = 0;
+        std::FILE* f = std::fopen(path.c_str(), "rb");
+        if (!f) throw InputError(path, 0, "cannot open the texture file" + system_reason());
+        std::fclose(f);
+        const char* why = stbi_failure_reason();
+        throw InputError(
+            path, 0,
+            std::string("cannot read the texture image (") + (why ? why : "unknown format") + ")");
+    }
+    if (width < 1 || height < 1 || long(width) * long(height) > max_image_pixels)
+        throw InputError(path, 0,
+                         "texture image is " + std::to_string(width) + " x " +
+                             std::to_string(height) + " pixels; at most " +
+                             std::to_string(max_image_pixels) + " pixels are accepted");
+    unsigned char* data = stbi_load(path.c_str(), &width, &height, &channels, 3);
+    if (!data) {
+        const char* why = stbi_failure_reason();
+        throw InputError(
+            path, 0,
+            std::string("cannot decode the texture image (") + (why ? why : "unknown error") + ")");
+    }
+    auto pixels = std::make_shared<Pixels>();
+    pixels->width = width;
+    pixels->height = height;
+    pixels->srgb = std::shared_ptr<const unsigned char>(
+        data, [](const unsigned char* p) { stbi_image_free(const_cast<unsigned char*>(p)); });
+    // sRGB decoding of the 256 possible 8-bit values, once.
+    pixels->decoded.resize(256);
+    for (int i = 0; i < 256; ++i) pixels->decoded[size_t(i)] = srgb_to_linear(i / 255.0);
+    summarize(*pixels);
+    return from_shared(std::move(pixels), scale, path);
+}
+
+long Texture::texel_bytes() const {
+    if (!pixels_) return 0;
+    const long n = long(pixels_->width) * pixels_->height;
+    // The 8-bit codes stb_image decoded (3 a texel) or the linear values (24 a texel).
+    return pixels_->srgb ? 3 * n : long(sizeof(Rgb)) * n;
+}
+
+Texture Texture::scaled(Rgb scale) const {
+    Texture t = *this;
+    t.a_ = a_ * scale;
+    t.b_ = b_ * scale;
+    t.scale_ = scale_ * scale;
+    return t;
+}
+
+Rgb Texture::value(double u, double v) const {
+    switch (kind_) {
+        case Kind::Constant:
+            return a_;
+        case Kind::Checker: {
+            // Square (i, j) holds [i/n, (i+1)/n) x [j/n, (j+1)/n); u = 1 belongs to the last one.
+            int i = std::min(int(clamp01(u) * n_), n_ - 1);
+            int j = std::min(int(clamp01(v) * n_), n_ - 1);
+            return (i + j) % 2 == 0 ? a_ : b_;
+        }
+        case Kind::Image: {
+            // Texel (x, y) sits at its centre ((x + 0.5)/w, 1 - (y + 0.5)/h); bilinear between
+            // centres, constant in the half texel along the border (clamp to edge).
+            const Pixels& p = *pixels_;
+            double fx = clamp01(u) * p.width - 0.5;
+            double fy = (1 - clamp01(v)) * p.height - 0.5;
+            fx = std::clamp(fx, 0.0, double(p.width - 1));
+            fy = std::clamp(fy, 0.0, double(p.height - 1));
+            int x0 = std::min(int(fx), p.width - 1), y0 = std::min(int(fy), p.height - 1);
+            int x1 = std::min(x0 + 1, p.width - 1), y1 = std::min(y0 + 1, p.height - 1);
+            double tx = fx - x0, ty = fy - y0;
+            Rgb blend = (1 - ty) * ((1 - tx) * p.texel(x0, y0) + tx * p.texel(x1, y0)) +
+                        ty * ((1 - tx) * p.texel(x0, y1) + tx * p.texel(x1, y1));
+            return scale_ * blend;
+        }
+    }
+    return {};
+}
+
+bool Texture::is_constant() const {
+    switch (kind_) {
+        case Kind::Constant:
+            return true;
+        case Kind::Checker:
+            return a_ == b_ || n_ == 1;
+        case Kind::Image:
+            return minimum() == maximum();
+    }
+    return true;
+}
+
+Rgb Texture::mean() const {
+    switch (kind_) {
+        case Kind::Constant:
+            return a_;
+        case Kind::Checker: {
+            // Squares with i + j even hold a: ceil(n^2 / 2) of them.
+            long n2 = long(n_) * n_;
+            long n_a = (n2 + 1) / 2;
+            return (double(n_a) * a_ + double(n2 - n_a) * b_) * (1.0 / double(n2));
+        }
+        case Kind::Image:
+            return scale_ * pixels_->mean;
+    }
+    return {};
+}
+
+Rgb Texture::minimum() const {
+    switch (kind_) {
+        case Kind::Constant:
+            return a_;
+        case Kind::Checker:
+            return n_ == 1 ? a_ : channel_min(a_, b_);
+        case Kind::Image:  // a negative scale turns the range around
+            return channel_min(scale_ * pixels_->lo, scale_ * pixels_->hi);
+    }
+    return {};
+}
+
+Rgb Texture::maximum() const {
+    switch (kind_) {
+        case Kind::Constant:
+            return a_;
+        case Kind::Checker:
+            return n_ == 1 ? a_ : channel_max(a_, b_);
+        case Kind::Image:
+            return channel_max(scale_ * pixels_->lo, scale_ * pixels_->hi);
+    }
+    return {};
+}
+
+}  // namespace mbr

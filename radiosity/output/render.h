@@ -1,0 +1,99 @@
+// radiosity/output/render.h - turning the solved radiosity into images: the camera's view of every
+// surface's radiosity B_i(u,v) (eq. (20), a SplineField per surface) as radiance B / pi, since
+// the surfaces are Lambertian (eq. (1)); then tone mapping to sRGB for PNG, Radiance RGBE (.hdr)
+// output of the linear radiance, and an overlay of the receivers' quadtrees (paper section 5) for
+// teaching. docs/method.md, "Rendering", lists the decisions.
+#pragma once
+
+#include <cstdint>
+#include <iosfwd>
+#include <string>
+#include <vector>
+
+#include "math/vec3.h"
+#include "octree/octree.h"
+#include "radiosity/output/image.h"
+#include "radiosity/geometry/quadtree.h"
+#include "radiosity/scene/scene.h"
+#include "radiosity/geometry/spline_field.h"
+
+namespace mbr {
+
+/// Options of the renderer.
+struct RenderOptions {
+    int samples_per_pixel = 4;                // jittered camera rays per pixel (>= 1); stratified
+                                              // on a k x k grid when a square k^2
+    std::uint64_t seed = 1;                   // jitter seed; pixel (x, y) draws from (seed, x, y)
+    double exposure = 1;                      // multiplier on radiance before tone mapping
+    bool quadtree_overlay = false;            // draw the quadtree leaves' boundaries (teaching)
+    Rgb overlay_colour = {0.08, 0.08, 0.08};  // their line colour, a display value in [0, 1]
+};
+
+/// Work done by a render.
+struct RenderStats {
+    long n_camera_rays = 0;  // rays cast (samples, plus one per pixel for the overlay)
+    long n_front_hits = 0;   // rays that met the front of a surface
+    long n_back_hits = 0;    // rays that met the back of a surface (zero radiance)
+    RayStats rays;           // octree work of those rays
+    /// Adds another part's counts.
+    RenderStats& operator+=(const RenderStats& other);
+};
+
+/// The pinhole ray of scene-format.md through image point (x, y) in pixels, (0, 0) the top left
+/// corner of the image and (width, height) the bottom right; the image's right is
+/// (look_at - eye) x up. The direction is not normalised (t counts distances to the image plane).
+Ray camera_ray(const Camera& camera, double x, double y);
+
+/// Radiance arriving along `ray`: at the first surface i hit, B_i(u, v) / pi by eq. (20) from
+/// radiosity[i] with (u, v) clamped to [0,1]^2; zero for a miss, for the back of a surface and
+/// for an empty field. Adds its counts to *stats if given.
+Rgb radiance_along(const Scene& scene, const Octree& octree,
+                   const std::vector<SplineField>& radiosity, const Ray& ray,
+                   RenderStats* stats = nullptr);
+
+/// The linear radiance image of scene.camera: per pixel the plain average (box filter) of
+/// options.samples_per_pixel radiance_along() samples jittered inside the pixel. radiosity[i] is
+/// the total radiosity of scene.surfaces[i] (emission included), the same number of them as
+/// surfaces. Parallel over rows; the image does not depend on the number of threads. Values are
+/// not clamped. *stats, if given, receives this render's counts.
+Image render_radiance(const Scene& scene, const Octree& octree,
+                      const std::vector<SplineField>& radiosity, const RenderOptions& options = {},
+                      RenderStats* stats = nullptr);
+
+/// The sRGB encoding function (IEC 61966-2-1): linear [0,1] to an encoded value in [0,1].
+double linear_to_srgb(double linear);
+
+/// Display values for write_png: exposure x radiance, clipped to [0,1] (NaN to 0), sRGB-encoded.
+Image tone_map(const Image& radiance, double exposure);
+
+/// Draws the boundaries of every surface's quadtree leaves, one pixel wide, in `colour` over a
+/// display image of scene.camera's size. A pixel is a line pixel when the (surface, leaf) seen
+/// through its centre differs from that of its right or lower neighbour. leaves[i] holds the
+/// leaves of surface i's quadtree over [0,1]^2 (cells outside the domain are ignored; an empty
+/// list makes the whole surface one cell); a null `leaves` treats every surface as one cell, so
+/// only the surfaces' outlines are drawn. Adds its camera rays to *stats if given.
+void draw_quadtree_overlay(Image& display, const Scene& scene, const Octree& octree,
+                           const std::vector<std::vector<DyadicCell>>* leaves, Rgb colour,
+                           RenderStats* stats = nullptr);
+
+/// The whole display pipeline: render_radiance, tone_map with options.exposure, and, when
+/// options.quadtree_overlay is on, draw_quadtree_overlay with `leaves`.
+Image render_display(const Scene& scene, const Octree& octree,
+                     const std::vector<SplineField>& radiosity, const RenderOptions& options = {},
+                     const std::vector<std::vector<DyadicCell>>* leaves = nullptr,
+                     RenderStats* stats = nullptr);
+
+/// Writes linear radiance in Radiance's RGBE format: the "#?RADIANCE" header with
+/// FORMAT=32-bit_rle_rgbe, the resolution line "-Y height +X width", then flat (uncompressed)
+/// scanlines, top row first. Negative and non-finite values are written as 0. RGBE keeps 8 bits
+/// of mantissa for the largest channel of a pixel: read back, every channel is within
+/// max(r, g, b) / 256 of its value.
+void write_hdr(std::ostream& out, const Image& radiance);
+
+/// Reads a Radiance RGBE image (flat or new-style run-length scanlines, "-Y h +X w" order,
+/// EXPOSURE lines divided out) into linear radiance. Throws InputError(name, 0, ...) when the
+/// stream is not such a file, is truncated or malformed, uses old-style run-length scanlines, or
+/// is larger than Texture::max_image_pixels.
+Image read_hdr(std::istream& in, const std::string& name);
+
+}  // namespace mbr

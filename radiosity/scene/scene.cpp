@@ -1,0 +1,52 @@
+// radiosity/scene/scene.cpp - helpers of the scene model (scene.h).
+#include "radiosity/scene/scene.h"
+
+#include "math/check.h"
+
+namespace mbr {
+
+int Scene::find_material(const std::string& name) const {
+    for (size_t i = 0; i < materials.size(); ++i)
+        if (materials[i].name == name) return int(i);
+    return -1;
+}
+
+int Scene::find_surface(const std::string& name) const {
+    for (size_t i = 0; i < surfaces.size(); ++i)
+        if (surfaces[i].name == name) return int(i);
+    return -1;
+}
+
+const Material& Scene::material_of(int surface) const {
+    MBR_CHECK_MSG(surface >= 0 && size_t(surface) < surfaces.size(), "surface " << surface);
+    int m = surfaces[surface].material;
+    MBR_CHECK_MSG(m >= 0 && size_t(m) < materials.size(), "material " << m);
+    return materials[m];
+}
+
+std::vector<int> Scene::emitters() const {
+    std::vector<int> out;
+    for (size_t i = 0; i < surfaces.size(); ++i)
+        if (material_of(int(i)).emits()) out.push_back(int(i));
+    return out;
+}
+
+double Scene::total_area() const {
+    double sum = 0;
+    for (const SceneSurface& s : surfaces) sum += s.surface.area();
+    return sum;
+}
+
+Rgb Scene::emitted_power() const {
+    Rgb sum;
+    for (int i : emitters()) sum += surfaces[i].surface.area() * material_of(i).emission.mean();
+    return sum;
+}
+
+Box3 Scene::bounds() const {
+    Box3 box;
+    for (const SceneSurface& s : surfaces) box.extend(s.surface.bounds());
+    return box;
+}
+
+}  // namespace mbr

@@ -1,0 +1,137 @@
+// radiosity/solver/cost.cpp - memory and time of a run from its settings ("bounded cost,
+// said before it is spent"). The figures are deliberately simple: a count the settings fix
+// (leaves, coefficients, polygons, texels) times bytes per item, so that the estimate is
+// monotone in every setting and errs on the high side.
+#include "radiosity/solver/cost.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <vector>
+
+#include "math/check.h"
+
+namespace mbr {
+
+namespace {
+
+// Calibration (Release build, m = 4, single_transfer --depth d with the default 256 x 256
+// error grid, peak resident size from /usr/bin/time -f %M): 6,488 KB at d = 0 (the program
+// itself), 8,692 KB at d = 6, 19,320 KB at d = 7, 60,988 KB at d = 8. Above the d = 0 base,
+// d = 7 -> 8 adds 41.7 MB for 49,152 more leaves, 6 -> 7 adds 10.6 MB for 12,288: about 850
+// bytes a leaf, of which the m x m samples (24 bytes each, 384) are the part that grows with m.
+// The rest (~470 bytes a leaf) is the node, the fulcrums, the coefficient map, the expanded
+// ring and the result.
+constexpr double bytes_per_leaf_fixed = 470;
+constexpr double bytes_per_sample = sizeof(Rgb);
+// Calibration of the time: the same runs took 3.7 s at d = 7 and 12.8 s at d = 8 of wall time on
+// two busy cores, ~2e-4 s a leaf. A rough figure for a warning, nothing more.
+constexpr double seconds_per_leaf = 2e-4;
+
+// Calibration of the polygons (octree_stats examples/scenes/room.scene --tessellation T
+// --rays 1000, peak resident size): 6,984 KB at T = 24 (2,558 polygons), 65,540 KB at T = 128
+// (66,830), 249,152 KB at T = 256 (264,718): about 930-945 bytes a polygon, counting the
+// facets, the polygons with their planes, and the octree's references and nodes.
+constexpr double bytes_per_polygon = 960;
+
+}  // namespace
+
+double field_bytes(int m, int level) {
+    MBR_CHECK(m >= 1 && level >= 0 && level <= 30);
+    const double side = std::ldexp(1.0, level) + m - 1;
+    return side * side * 3 * sizeof(double);
+}
+
+double transfer_bytes(int m, int depth) {
+    MBR_CHECK(m >= 1 && depth >= 0 && depth <= 30);
+    const double leaves = std::ldexp(1.0, 2 * depth);
+    return leaves * (bytes_per_leaf_fixed + double(m) * m * bytes_per_sample);
+}
+
+double transfer_seconds(int m, int depth) {
+    MBR_CHECK(m >= 1 && depth >= 0 && depth <= 30);
+    // Samples (m^2 a leaf) dominate; the calibration is at m = 4.
+    return std::ldexp(1.0, 2 * depth) * seconds_per_leaf * (double(m) * m / 16);
+}
+
+CostEstimate transfer_cost(const ReceiverOptions& o) {
+    CostEstimate c;
+    c.bytes = transfer_bytes(o.m, o.max_depth);
+    c.seconds = transfer_seconds(o.m, o.max_depth);
+    c.detail = std::to_string(1L << (2 * std::min(o.max_depth, 30))) + " receiver leaves of " +
+               std::to_string(o.m * o.m) + " samples";
+    return c;
+}
+
+CostEstimate scene_cost(const Scene& scene, const SolverOptions& options, int threads) {
+    const int m = options.receiver.m, d = options.receiver.max_depth;
+    const double n_surfaces = double(scene.surfaces.size());
+    // Radiosity and unshot per surface, and every receiver's result of one shot held at once.
+    const double fields = 3 * n_surfaces * field_bytes(m, d);
+    // Transfers run one per thread over the receivers, except with the paper's fractions,
+    // which run one transfer at a time, parallel inside.
+    const bool one_at_a_time = options.receiver.shadows.method == ShadowMethod::Fractions;
+    const double at_once =
+        std::max(1.0, std::min(one_at_a_time ? 1.0 : double(std::max(1, threads)), n_surfaces));
+    const double transfers = at_once * transfer_bytes(m, d);
+    double polygons = 0;
+    for (const SceneSurface& s : scene.surfaces) {
+        polygons += double(s.surface.facet_count(scene.settings.tessellation)) * bytes_per_polygon;
+    }
+    // Each distinct texel storage once: materials sharing an image share its texels.
+    std::vector<const Texture*> seen;
+    double textures = 0;
+    for (const Material& mat : scene.materials)
+        for (const Texture* t : {&mat.reflectance, &mat.emission}) {
+            if (t->texel_bytes() == 0) continue;
+            const bool shared = std::any_of(seen.begin(), seen.end(),
+                                            [&](const Texture* u) { return u->shares_texels(*t); });
+            if (shared) continue;
+            seen.push_back(t);
+            textures += double(t->texel_bytes());
+        }
+    CostEstimate c;
+    c.bytes = fields + transfers + polygons + textures;
+    c.seconds = n_surfaces * transfer_seconds(m, d);  // one shot's transfers, each a full tree
+    c.detail = "fields " + format_bytes(fields) + ", transfers " + format_bytes(transfers) +
+               ", polygons " + format_bytes(polygons) + ", textures " + format_bytes(textures);
+    return c;
+}
+
+double physical_memory_bytes() {
+    const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGE_SIZE);
+    return pages > 0 && page > 0 ? double(pages) * double(page) : 0;
+}
+
+double default_memory_budget() {
+    const double physical = physical_memory_bytes();
+    // DESIGN: half the machine: the run, the system and whatever else runs beside it.
+    return physical > 0 ? physical / 2 : 4.0 * (1L << 30);
+}
+
+std::string format_bytes(double bytes) {
+    const char* units[] = {"B", "KiB", "MiB", "GiB", "TiB", "PiB"};
+    int u = 0;
+    while (bytes >= 1024 && u < 5) {
+        bytes /= 1024;
+        ++u;
+    }
+    char buf[64];
+    std::snprintf(buf, sizeof buf, u == 0 ? "%.0f %s" : "%.1f %s", bytes, units[u]);
+    return buf;
+}
+
+std::string format_seconds(double seconds) {
+    char buf[64];
+    if (seconds >= 7200)
+        std::snprintf(buf, sizeof buf, "%.0f h", seconds / 3600);
+    else if (seconds >= 120)
+        std::snprintf(buf, sizeof buf, "%.0f min", seconds / 60);
+    else
+        std::snprintf(buf, sizeof buf, "%.0f s", seconds);
+    return buf;
+}
+
+}  // namespace mbr

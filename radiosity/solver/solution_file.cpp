@@ -1,0 +1,223 @@
+// radiosity/solver/solution_file.cpp - saving and loading solved fields (docs/solution-format.md), so
+// that rendering can be separate from solving.
+#include <cinttypes>
+#include <cstdio>
+#include <cstring>
+#include <istream>
+#include <ostream>
+#include <sstream>
+
+#include "math/bspline.h"
+#include "math/check.h"
+#include "radiosity/solver/solver.h"
+
+namespace mbr {
+
+namespace {
+
+constexpr const char* magic = "mbr-solution";
+constexpr int format_version = 1;
+
+std::uint64_t mix(std::uint64_t h, std::uint64_t x) {
+    h ^= x + 0x9e3779b97f4a7c15ULL + (h << 6) + (h >> 2);
+    return h;
+}
+std::uint64_t mix(std::uint64_t h, double x) {
+    std::uint64_t b;
+    std::memcpy(&b, &x, sizeof b);
+    return mix(h, b);
+}
+std::uint64_t mix(std::uint64_t h, const std::string& s) {
+    for (unsigned char c : s) h = mix(h, std::uint64_t(c));
+    return mix(h, std::uint64_t(s.size()));
+}
+
+void write_field(std::ostream& out, const char* what, const SplineField& f) {
+    out << what << " level " << f.level() << "\n";
+    char buf[40];
+    for (int c = 0; c < 3; ++c) {
+        const std::vector<double>& a = f.channel(c).a;
+        for (size_t i = 0; i < a.size(); ++i) {
+            std::snprintf(buf, sizeof buf, "%.17g", a[i]);
+            out << (i ? " " : "") << buf;
+        }
+        out << "\n";
+    }
+}
+
+/// Reads the file line by line and reports problems with the file name and line.
+class Reader {
+public:
+    Reader(std::istream& in, const std::string& name) : in_(in), name_(name) {}
+    std::vector<std::string> words(const char* expecting) {
+        std::string line;
+        if (!std::getline(in_, line))
+            fail("the file ends early (expected " + std::string(expecting) + "): truncated?");
+        ++line_;
+        if (line.size() > (size_t(1) << 26)) fail("line is too long");
+        std::istringstream is(line);
+        std::vector<std::string> out;
+        for (std::string w; is >> w;) out.push_back(w);
+        return out;
+    }
+    [[noreturn]] void fail(const std::string& message) const {
+        throw InputError(name_, line_, message);
+    }
+    long integer(const std::string& w, long lo, long hi, const char* what) const {
+        char* end = nullptr;
+        errno = 0;
+        const long v = std::strtol(w.c_str(), &end, 10);
+        if (w.empty() || *end != '\0' || errno != 0 || v < lo || v > hi)
+            fail(std::string("expected ") + what + " in " + std::to_string(lo) + ".." +
+                 std::to_string(hi) + ", found '" + w + "'");
+        return v;
+    }
+    double number(const std::string& w) const {
+        char* end = nullptr;
+        const double v = std::strtod(w.c_str(), &end);
+        if (w.empty() || *end != '\0' || !std::isfinite(v))
+            fail("expected a finite number, found '" + w + "'");
+        return v;
+    }
+    void expect(const std::vector<std::string>& got, const std::string& first, size_t n) const {
+        if (got.empty() || got[0] != first || got.size() != n)
+            fail("expected '" + first + "' with " + std::to_string(n - 1) + " values");
+    }
+
+private:
+    std::istream& in_;
+    std::string name_;
+    int line_ = 0;
+};
+
+SplineField read_field(Reader& r, const char* what, int m) {
+    const std::vector<std::string> head = r.words(what);
+    r.expect(head, what, 3);
+    if (head[1] != "level") r.fail(std::string("expected '") + what + " level J'");
+    const int level = int(r.integer(head[2], 0, 14, "a level"));
+    // The count is checked against the first line before the field is made: a level-14 field of
+    // order 8 holds 3 x 2.7e8 coefficients (6 GiB), which a damaged 20-byte header must not
+    // allocate (found by test/fuzz_readers.cpp).
+    const size_t n_coefficients = size_t(touching_count(m, level)) * touching_count(m, level);
+    std::vector<std::string> values = r.words("coefficients");
+    const auto check_count = [&] {
+        if (values.size() != n_coefficients)
+            r.fail("expected " + std::to_string(n_coefficients) + " coefficients, found " +
+                   std::to_string(values.size()));
+    };
+    check_count();
+    SplineField f(m, level);
+    for (int c = 0; c < 3; ++c) {
+        if (c > 0) {
+            values = r.words("coefficients");
+            check_count();
+        }
+        std::vector<double>& a = f.channel(c).a;
+        for (size_t i = 0; i < a.size(); ++i) a[i] = r.number(values[i]);
+    }
+    return f;
+}
+
+}  // namespace
+
+std::uint64_t scene_fingerprint(const Scene& scene) {
+    std::uint64_t h = 1469598103934665603ULL;
+    h = mix(h, std::uint64_t(scene.surfaces.size()));
+    for (const SceneSurface& s : scene.surfaces) {
+        h = mix(h, s.name);
+        h = mix(h, std::uint64_t(s.surface.kind()));
+        for (double u : {0.0, 0.5, 1.0})
+            for (double v : {0.0, 0.5, 1.0}) {
+                const Vec3 p = s.surface.point(u, v);
+                h = mix(mix(mix(h, p.x), p.y), p.z);
+            }
+        const Material& mat = scene.materials[s.material];
+        for (const Rgb& c : {mat.reflectance.mean(), mat.emission.mean()})
+            h = mix(mix(mix(h, c.r), c.g), c.b);
+    }
+    return h;
+}
+
+void save_solution(std::ostream& out, const Scene& scene, const Solution& solution) {
+    MBR_CHECK(solution.radiosity.size() == scene.surfaces.size() &&
+              solution.unshot.size() == scene.surfaces.size());
+    char fp[32];
+    std::snprintf(fp, sizeof fp, "%016" PRIx64, scene_fingerprint(scene));
+    int m = 0;
+    for (const SplineField& f : solution.radiosity) m = std::max(m, f.order());
+    out << magic << " " << format_version << "\n"
+        << "fingerprint " << fp << "\n"
+        << "surfaces " << scene.surfaces.size() << " order " << m << "\n";
+    for (size_t i = 0; i < scene.surfaces.size(); ++i) {
+        out << "surface " << i << " " << scene.surfaces[i].name << "\n";
+        write_field(out, "radiosity", solution.radiosity[i]);
+        write_field(out, "unshot", solution.unshot[i]);
+        const std::vector<DyadicCell> none;
+        const std::vector<DyadicCell>& leaves =
+            i < solution.leaves.size() ? solution.leaves[i] : none;
+        out << "leaves " << leaves.size() << "\n";
+        for (size_t k = 0; k < leaves.size(); ++k)
+            out << (k ? " " : "") << leaves[k].level << " " << leaves[k].i << " " << leaves[k].j;
+        out << "\n";
+    }
+    out << "end\n";
+}
+
+Solution load_solution(std::istream& in, const std::string& name, const Scene& scene) {
+    Reader r(in, name);
+    const std::vector<std::string> head = r.words("the header");
+    if (head.size() != 2 || head[0] != magic)
+        r.fail("not an mbr solution file (no 'mbr-solution' header)");
+    const long version = r.integer(head[1], 0, 1000000, "a format version");
+    if (version != format_version)
+        r.fail("solution format version " + std::to_string(version) +
+               " is not supported (this mbr reads version " + std::to_string(format_version) + ")");
+    const std::vector<std::string> fp = r.words("the fingerprint");
+    r.expect(fp, "fingerprint", 2);
+    char expected[32];
+    std::snprintf(expected, sizeof expected, "%016" PRIx64, scene_fingerprint(scene));
+    if (fp[1] != expected)
+        r.fail(
+            "the solution was made for another scene (or the scene changed since): fingerprint " +
+            fp[1] + ", the scene's is " + expected);
+    const std::vector<std::string> sizes = r.words("the surface count");
+    r.expect(sizes, "surfaces", 4);
+    const long n = r.integer(sizes[1], 0, 100000000, "a surface count");
+    if (size_t(n) != scene.surfaces.size())
+        r.fail("the solution has " + std::to_string(n) + " surfaces, the scene " +
+               std::to_string(scene.surfaces.size()));
+    if (sizes[2] != "order") r.fail("expected 'order M'");
+    const int m = int(r.integer(sizes[3], 2, 8, "an order"));
+    Solution s;
+    s.radiosity.resize(n);
+    s.unshot.resize(n);
+    s.leaves.resize(n);
+    for (long i = 0; i < n; ++i) {
+        const std::vector<std::string> sh = r.words("a surface");
+        r.expect(sh, "surface", 3);
+        if (r.integer(sh[1], 0, n - 1, "a surface index") != i) r.fail("surfaces are out of order");
+        if (sh[2] != scene.surfaces[i].name)
+            r.fail("surface " + std::to_string(i) + " is '" + sh[2] + "', the scene's is '" +
+                   scene.surfaces[i].name + "'");
+        s.radiosity[i] = read_field(r, "radiosity", m);
+        s.unshot[i] = read_field(r, "unshot", m);
+        const std::vector<std::string> lh = r.words("leaves");
+        r.expect(lh, "leaves", 2);
+        const long n_leaves = r.integer(lh[1], 0, 1L << 30, "a leaf count");
+        const std::vector<std::string> cells = r.words("leaf cells");
+        if (cells.size() != size_t(3 * n_leaves))
+            r.fail("expected " + std::to_string(3 * n_leaves) + " numbers of leaf cells");
+        for (long k = 0; k < n_leaves; ++k) {
+            const int level = int(r.integer(cells[3 * k], 0, 30, "a cell level"));
+            const long limit = (1L << level) - 1;
+            s.leaves[i].push_back({level,
+                                   int(r.integer(cells[3 * k + 1], 0, limit, "a cell index")),
+                                   int(r.integer(cells[3 * k + 2], 0, limit, "a cell index"))});
+        }
+    }
+    const std::vector<std::string> end = r.words("'end'");
+    if (end.size() != 1 || end[0] != "end") r.fail("expected 'end'");
+    return s;
+}
+
+}  // namespace mbr

@@ -1,0 +1,555 @@
+// radiosity/solver/solver.cpp - progressive refinement over a whole scene (paper section 4).
+#include "radiosity/solver/solver.h"
+
+#include <sys/resource.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <limits>
+#include <set>
+
+#include "math/bspline.h"
+#include "math/check.h"
+#include "math/gauss_legendre.h"
+#include "math/parallel.h"
+#include "radiosity/visibility/visible_parts.h"
+
+namespace mbr {
+
+namespace {
+
+double now() {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch())
+        .count();
+}
+
+double channel_sum(Rgb c) {
+    return c.r + c.g + c.b;
+}
+
+long peak_memory_bytes() {
+    rusage usage{};
+    getrusage(RUSAGE_SELF, &usage);
+    return long(usage.ru_maxrss) * 1024;  // Linux reports kilobytes
+}
+
+/// Dense Cholesky solve of G x = b for a small symmetric positive definite G (row-major n x n).
+std::vector<double> cholesky_solve(std::vector<double> G, std::vector<double> b, int n) {
+    for (int j = 0; j < n; ++j) {
+        double d = G[j * n + j];
+        for (int k = 0; k < j; ++k) d -= G[j * n + k] * G[j * n + k];
+        MBR_CHECK_MSG(d > 0, "Gram matrix not positive definite");
+        G[j * n + j] = std::sqrt(d);
+        for (int i = j + 1; i < n; ++i) {
+            double s = G[i * n + j];
+            for (int k = 0; k < j; ++k) s -= G[i * n + k] * G[j * n + k];
+            G[i * n + j] = s / G[j * n + j];
+        }
+    }
+    for (int i = 0; i < n; ++i) {
+        double s = b[i];
+        for (int k = 0; k < i; ++k) s -= G[i * n + k] * b[k];
+        b[i] = s / G[i * n + i];
+    }
+    for (int i = n - 1; i >= 0; --i) {
+        double s = b[i];
+        for (int k = i + 1; k < n; ++k) s -= G[k * n + i] * b[k];
+        b[i] = s / G[i * n + i];
+    }
+    return b;
+}
+
+/// How far the other surface's hull reaches in front of the planar one's plane (its largest
+/// signed distance), and the plane tolerance of behind() below.
+double front_reach(const Surface& planar, const Surface& other, double* tolerance) {
+    const Vec3 n = planar.normal(0.5, 0.5);
+    const Vec3 o = planar.point(0.5, 0.5);
+    const Box3 b = planar.bounds();
+    *tolerance = 1e-9 * std::max(length(b.extent()), length(o));
+    double reach = -std::numeric_limits<double>::infinity();
+    for (const Vec3& q : hull_points(other)) reach = std::max(reach, dot(n, q - o));
+    return reach;
+}
+
+/// The points of one planar surface's hull on the far side of the other's plane (or all on its
+/// plane): nothing can pass between them. Curved surfaces are never ruled out here.
+bool behind(const Surface& planar, const Surface& other) {
+    if (!planar.is_planar()) return false;
+    double tolerance = 0;
+    return front_reach(planar, other, &tolerance) <= tolerance;
+}
+
+std::uint64_t cell_key(const DyadicCell& c) {
+    return (std::uint64_t(c.level) << 56) | (std::uint64_t(std::uint32_t(c.i)) << 28) |
+           std::uint64_t(std::uint32_t(c.j));
+}
+
+}  // namespace
+
+std::vector<NearContact> near_contacts(const Scene& scene) {
+    std::vector<NearContact> found;
+    const int n = static_cast<int>(scene.surfaces.size());
+    const std::vector<int> emitters = scene.emitters();
+    std::vector<bool> emits(size_t(n), false);
+    for (int e : emitters) emits[size_t(e)] = true;
+    for (int e : emitters)
+        for (int i = 0; i < n; ++i) {
+            if (i == e || (emits[size_t(i)] && i < e)) continue;  // each pair once
+            for (const auto& [a, b] : {std::pair{e, i}, std::pair{i, e}}) {
+                const Surface& planar = scene.surfaces[size_t(a)].surface;
+                if (!planar.is_planar()) continue;
+                double tolerance = 0;
+                const double reach =
+                    front_reach(planar, scene.surfaces[size_t(b)].surface, &tolerance);
+                // Above rounding (1e-4 of the tolerance, 1e-13 of the size) and within the
+                // tolerance: apart, but treated as lying on the plane.
+                if (reach > 1e-4 * tolerance && reach <= tolerance) {
+                    found.push_back({a, b, reach});
+                    break;  // one report per pair
+                }
+            }
+        }
+    return found;
+}
+
+SolverOptions solver_options(const SolverSettings& s) {
+    SolverOptions o;
+    // DESIGN: in a scene every shooter partition refines its worst cell first (the sum of the
+    // error estimates is bounded as the paper's rule bounds it, with far fewer cells on spline
+    // shooters); see docs/method.md.
+    o.receiver.quadrature.global = true;
+    // DESIGN: 4 against 5 points per cell: a scene's tolerances are absolute and coarse, where
+    // the lower pair needs half the kernel evaluations of 6 against 7 (docs/method.md).
+    o.receiver.quadrature.n = 4;
+    // DESIGN: every finest-level coefficient projected on the fine grid (project_fine_grid):
+    // adaptive trees then reach the accuracy of uniform ones (docs/method.md, adaptive study).
+    o.receiver.unify_by_projection = s.unify == "projection";
+    // DESIGN: cost follows energy (measured on the Cornell box, docs/method.md): a receiver
+    // that gets less than 10 absolute tolerances starts its oracle at the root, the shadowed
+    // part's triangles use 3 against 4 points, edgefill stops 2 levels below the finest
+    // boundary leaf.
+    o.receiver.weak_receiver = 10;
+    // DESIGN: cells touching a planar shooter split to contact_depth (2) whatever the oracle
+    // says (ReceiverOptions::contact_depth; measured on the cubes and the Cornell box,
+    // docs/method.md).
+    o.receiver.contact_depth = s.contact_depth;
+    // DESIGN: cells touching a planar shooter may take the Interpolation test of the oracle
+    // (`set contact_oracle interpolation`): what the uniform cube's corners need; on the
+    // Cornell box it gains less than it costs (ReceiverOptions::contact_oracle_test,
+    // docs/method.md).
+    o.receiver.contact_oracle_test =
+        s.contact_oracle == "interpolation" ? OracleTest::Interpolation : OracleTest::Means;
+    o.receiver.quadrature.n_pieces = 3;
+    o.receiver.edgefill_max_depth = 2;
+    o.receiver.m = s.order;
+    o.receiver.min_depth = s.min_depth;
+    o.receiver.max_depth = s.max_depth;
+    o.receiver.oracle_tolerance = s.oracle_tolerance;
+    o.receiver.truncation_eps = s.truncation_eps;
+    o.receiver.rhombus_radius = s.rhombus_radius;
+    o.receiver.extrapolation =
+        s.extrapolation == "linear" ? Extrapolation::Linear : Extrapolation::Quadratic;
+    o.receiver.shadows.rays_per_patch = s.shadow_rays;
+    o.receiver.shadows.method = s.shadows == "exact"   ? ShadowMethod::Exact
+                                : s.shadows == "paper" ? ShadowMethod::Fractions
+                                                       : ShadowMethod::None;
+    o.max_shots = s.max_shots;
+    o.convergence = s.convergence;
+    o.self_transfer = s.self_transfer;
+    o.tolerance = s.tolerance;
+    o.ambient = s.ambient;
+    o.hidden_regions = s.hidden;
+    o.shooter_level = s.shooter_level;
+    return o;
+}
+
+SplineField project_emission(const Texture& emission, int m, int level) {
+    if (emission.is_constant()) return SplineField::constant(m, 0, emission.value(0.5, 0.5));
+    // L2([0,1]^2) projection onto the touching basis of the level: (G x G) c = b with
+    // b_kl = int int E N_k N_l by 8 x 8 Gauss points per cell (textures are only piecewise
+    // smooth) and the 1D Gram matrix G, exact by m-point Gauss per cell.
+    const int first = first_touching_index(m), n = touching_count(m, level), cells = 1 << level;
+    const GaussLegendre rule_g = gauss_legendre(m), rule_b = gauss_legendre(8);
+    std::vector<double> G(size_t(n) * n, 0.0);
+    double v[16];
+    for (int cell = 0; cell < cells; ++cell)
+        for (int q = 0; q < rule_g.n(); ++q) {
+            const double s = (cell + 0.5 * (rule_g.x[q] + 1)) / cells;
+            const int fk = bspline_values(m, std::ldexp(s, level), v);
+            const double w = 0.5 * rule_g.w[q] / cells;
+            for (int a = 0; a < m; ++a)
+                for (int b = 0; b < m; ++b) {
+                    const int ka = fk + a - first, kb = fk + b - first;
+                    if (ka >= 0 && ka < n && kb >= 0 && kb < n)
+                        G[size_t(ka) * n + kb] += w * v[a] * v[b];
+                }
+        }
+    SplineField field(m, level);
+    for (int c = 0; c < 3; ++c) {
+        std::vector<double> B(size_t(n) * n, 0.0);  // B[k][l]
+        double vs[16], vt[16];
+        for (int ci = 0; ci < cells; ++ci)
+            for (int qa = 0; qa < rule_b.n(); ++qa) {
+                const double s = (ci + 0.5 * (rule_b.x[qa] + 1)) / cells;
+                const int fk = bspline_values(m, std::ldexp(s, level), vs);
+                for (int cj = 0; cj < cells; ++cj)
+                    for (int qb = 0; qb < rule_b.n(); ++qb) {
+                        const double t = (cj + 0.5 * (rule_b.x[qb] + 1)) / cells;
+                        const int fl = bspline_values(m, std::ldexp(t, level), vt);
+                        const double w =
+                            0.25 * rule_b.w[qa] * rule_b.w[qb] / (double(cells) * cells);
+                        const double e = w * emission.value(s, t)[c];
+                        for (int a = 0; a < m; ++a)
+                            for (int b = 0; b < m; ++b) {
+                                const int k = fk + a - first, l = fl + b - first;
+                                if (k >= 0 && k < n && l >= 0 && l < n)
+                                    B[size_t(k) * n + l] += e * vs[a] * vt[b];
+                            }
+                    }
+            }
+        // C = G^-1 B G^-1: solve column by column, then row by row.
+        std::vector<double> col(n);
+        for (int l = 0; l < n; ++l) {
+            for (int k = 0; k < n; ++k) col[k] = B[size_t(k) * n + l];
+            col = cholesky_solve(G, col, n);
+            for (int k = 0; k < n; ++k) B[size_t(k) * n + l] = col[k];
+        }
+        for (int k = 0; k < n; ++k) {
+            std::vector<double> row(B.begin() + size_t(k) * n, B.begin() + size_t(k + 1) * n);
+            row = cholesky_solve(G, row, n);
+            for (int l = 0; l < n; ++l) field.channel(c)(first + k, first + l) = row[l];
+        }
+    }
+    return field;
+}
+
+// ---- The loop -----------------------------------------------------------------------------
+
+ProgressiveSolver::ProgressiveSolver(const Scene& scene, const Octree& octree,
+                                     const SolverOptions& options)
+    : scene_(scene), octree_(octree), options_(options), dual_(options.receiver.m) {
+    start_seconds_ = now();
+    const int n = static_cast<int>(scene.surfaces.size());
+    const int m = options.receiver.m;
+    solution_.radiosity.resize(n);
+    solution_.unshot.resize(n);
+    solution_.leaves.resize(n);
+    split_cells_.resize(n);
+    coupling_.resize(n);
+    shot_power_.assign(n, Rgb{});
+    last_seconds_.assign(n, 0.0);
+    weights_.resize(n);
+    hidden_.resize(n);
+    if (options.hidden_regions)
+        for (int i = 0; i < n; ++i) hidden_[i] = find_hidden(scene.surfaces[i].surface, i, octree, options.hidden);
+    // "for each emitting surface L_i compute the projection of its emittance distribution".
+    double emitted = 0;
+    Rgb emitted_rgb;
+    for (int i = 0; i < n; ++i) {
+        const Material& mat = scene.material_of(i);
+        if (mat.emits()) {
+            solution_.radiosity[i] = project_emission(mat.emission, m, options.emission_level);
+            solution_.unshot[i] = solution_.radiosity[i];
+            const Rgb p = power(i, solution_.unshot[i]);
+            emitted += channel_sum(p);
+            emitted_rgb += p;
+        } else {
+            solution_.radiosity[i] = SplineField::constant(m, 0, {0, 0, 0});
+            solution_.unshot[i] = SplineField::constant(m, 0, {0, 0, 0});
+        }
+    }
+    solution_.stats.emitted_power = emitted;
+    solution_.stats.unshot_power = emitted;
+    const double area = scene.total_area();
+    radiosity_scale_ =
+        area > 0 ? std::max({emitted_rgb.r, emitted_rgb.g, emitted_rgb.b}) / area : 0;
+}
+
+const std::vector<double>& ProgressiveSolver::power_weights(int surface, int level) const {
+    std::vector<std::vector<double>>& cache = weights_[surface];
+    if (int(cache.size()) <= level) cache.resize(level + 1);
+    std::vector<double>& w = cache[level];
+    if (!w.empty()) return w;
+    // w_kl = int int N_m(2^j s - k) N_m(2^j t - l) A(s, t) ds dt, by (m + 2)-point Gauss per
+    // cell: exact for planar quads (A is linear in s and t), accurate for curved surfaces.
+    const int m = options_.receiver.m;
+    const int first = first_touching_index(m), n = touching_count(m, level), cells = 1 << level;
+    const GaussLegendre rule = gauss_legendre(m + 2);
+    const Surface& S = scene_.surfaces[surface].surface;
+    w.assign(size_t(n) * n, 0.0);
+    double vs[16], vt[16];
+    for (int ci = 0; ci < cells; ++ci)
+        for (int qa = 0; qa < rule.n(); ++qa) {
+            const double s = (ci + 0.5 * (rule.x[qa] + 1)) / cells;
+            const int fk = bspline_values(m, std::ldexp(s, level), vs);
+            for (int cj = 0; cj < cells; ++cj)
+                for (int qb = 0; qb < rule.n(); ++qb) {
+                    const double t = (cj + 0.5 * (rule.x[qb] + 1)) / cells;
+                    const int fl = bspline_values(m, std::ldexp(t, level), vt);
+                    const double a = 0.25 * rule.w[qa] * rule.w[qb] / (double(cells) * cells) *
+                                     S.area_factor(s, t);
+                    for (int p = 0; p < m; ++p)
+                        for (int q = 0; q < m; ++q) {
+                            const int k = fk + p - first, l = fl + q - first;
+                            if (k >= 0 && k < n && l >= 0 && l < n)
+                                w[size_t(k) * n + l] += a * vs[p] * vt[q];
+                        }
+                }
+        }
+    return w;
+}
+
+Rgb ProgressiveSolver::power(int surface, const SplineField& field) const {
+    // int B A = sum_kl c_kl w_kl (the B-splines' weights against the area factor).
+    const std::vector<double>& w = power_weights(surface, field.level());
+    Rgb p;
+    for (int c = 0; c < 3; ++c) {
+        const std::vector<double>& a = field.channel(c).a;
+        double sum = 0;
+        for (size_t i = 0; i < a.size(); ++i) sum += a[i] * w[i];
+        p[c] = sum;
+    }
+    return p;
+}
+
+double ProgressiveSolver::unshot_power(int surface) const {
+    return channel_sum(power(surface, solution_.unshot[surface]));
+}
+
+bool ProgressiveSolver::done() const {
+    const SolveStats& st = solution_.stats;
+    if (st.shots >= options_.max_shots) return true;
+    double largest = 0;
+    for (int i = 0; i < int(scene_.surfaces.size()); ++i)
+        largest = std::max(largest, unshot_power(i));
+    return largest <= options_.convergence * st.emitted_power;
+}
+
+ShotStats ProgressiveSolver::shoot() {
+    const double start = now();
+    const int n = static_cast<int>(scene_.surfaces.size());
+    ShotStats shot;
+    shot.shot = solution_.stats.shots + 1;
+    // "pick out the surface A_jm which has the largest value of int int_Aj dB" (sum of the
+    // channels' unshot power; ties to the lowest index).
+    std::vector<double> unshot(n);
+    for (int i = 0; i < n; ++i) {
+        unshot[i] = unshot_power(i);
+        shot.unshot_before += unshot[i];
+        if (shot.shooter < 0 || unshot[i] > unshot[shot.shooter]) shot.shooter = i;
+    }
+    const int h = shot.shooter;
+    shot.shooter_power = unshot[h];
+    const Surface& shooter_surface = scene_.surfaces[h].surface;
+
+    // The receivers: every surface that can see the shooter's front and be seen by it.
+    std::vector<int> receivers;
+    for (int i = 0; i < n; ++i) {
+        const Surface& r = scene_.surfaces[i].surface;
+        if (i == h) {
+            if (options_.self_transfer && r.is_concave()) receivers.push_back(i);
+            continue;
+        }
+        if (max_abs(scene_.material_of(i).reflectance.maximum()) == 0)
+            continue;  // reflects nothing
+        if (behind(shooter_surface, r) || behind(r, shooter_surface)) continue;
+        receivers.push_back(i);
+    }
+    shot.receivers = static_cast<int>(receivers.size());
+
+    // Tolerances against the scene's scale (cost follows energy).
+    ReceiverOptions ro = options_.receiver;
+    ro.absolute_tolerance = options_.tolerance * radiosity_scale_;
+    ro.quadrature.abs_tolerance = options_.quadrature_share * ro.absolute_tolerance;
+    const SplineField& unshot_h = solution_.unshot[h];
+    const int coarsen = std::max(ro.shooter_coarsening, unshot_h.level() - options_.shooter_level);
+    const Shooter shooter = make_shooter(shooter_surface, unshot_h, coarsen);
+
+    struct Received {
+        SplineField field;
+        TransferStats stats;
+        std::vector<std::uint64_t> splits;
+    };
+    std::vector<Received> results(receivers.size());
+    // The big transfers first would balance better, but each receiver's result must not depend
+    // on the schedule: it does not (each transfer is independent), only the time does.
+    const int n_rec = static_cast<int>(receivers.size());
+    auto run_one = [&](int k) {
+        const int i = receivers[k];
+        const Texture& rho = scene_.material_of(i).reflectance;
+        const ReceiverSurface receiver{&scene_.surfaces[i].surface,
+                                       [&rho](double s, double t) { return rho.value(s, t); },
+                                       hidden_[i].any() ? &hidden_[i] : nullptr};
+        const OcclusionContext occlusion = make_occlusion_context(
+            octree_, shooter_surface, h, scene_.surfaces[i].surface, i, std::uint64_t(shot.shot));
+        ReceiverState state;
+        results[k].field =
+            transfer(shooter, receiver, ro, &results[k].stats, &state, &occlusion, &dual_);
+        for (int index = 0; index < state.forest.n_nodes(); ++index) {
+            const Forest::Node& node = state.forest.node(index);
+            if (!node.is_leaf() && node.cell.in_domain())
+                results[k].splits.push_back(cell_key(node.cell));
+        }
+    };
+    if (ro.shadows.method == ShadowMethod::Fractions || n_rec == 1) {
+        // One transfer at a time, each parallel inside (stage 7 needs its fractions in parallel).
+        for (int k = 0; k < n_rec; ++k) run_one(k);
+    } else {
+        // The receivers that took longest last time first, so that no thread is left with one
+        // big transfer at the end (the results do not depend on the order).
+        std::vector<int> order(n_rec);
+        for (int k = 0; k < n_rec; ++k) order[k] = k;
+        std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
+            return last_seconds_[receivers[a]] > last_seconds_[receivers[b]];
+        });
+        parallel_for(n_rec, [&](int k) { run_one(order[k]); });
+    }
+    for (int k = 0; k < n_rec; ++k) last_seconds_[receivers[k]] = results[k].stats.seconds_total;
+
+    // Superposition in receiver order: B_i += dB_i, B_unshot_i += dB_i; then B_unshot_h = 0.
+    const Rgb shot_power = power(h, shooter.unshot);
+    std::vector<Rgb>& row = coupling_[h];
+    if (row.empty()) row.assign(n, Rgb{});
+    shot_power_[h] += shot_power;
+    for (int k = 0; k < n_rec; ++k) {
+        const int i = receivers[k];
+        Received& r = results[k];
+        const Rgb reflected = power(i, r.field);
+        shot.reflected += channel_sum(reflected);
+        // Incident power: what was reflected over the reflectance (its mean for a texture).
+        const Rgb rv = scene_.material_of(i).reflectance.mean();
+        for (int c = 0; c < 3; ++c)
+            if (rv[c] > 0) {
+                const double incident = reflected[c] / rv[c];
+                shot.incident += incident;
+                row[i][c] += incident;
+            }
+        solution_.radiosity[i].add(r.field);
+        solution_.unshot[i].add(r.field);
+        shot.kernel_evals += r.stats.n_kernel_evals;
+        shot.rays += r.stats.n_rays;
+        shot.finest_level = std::max(shot.finest_level, r.field.level());
+        std::vector<std::uint64_t>& cells = split_cells_[i];
+        cells.insert(cells.end(), r.splits.begin(), r.splits.end());
+        std::sort(cells.begin(), cells.end());
+        cells.erase(std::unique(cells.begin(), cells.end()), cells.end());
+    }
+    if (!(options_.self_transfer && shooter_surface.is_concave() &&
+          std::find(receivers.begin(), receivers.end(), h) != receivers.end())) {
+        solution_.unshot[h] = SplineField::constant(options_.receiver.m, 0, {0, 0, 0});
+    } else {
+        // The shooter received from itself during the shot: keep only what it received.
+        for (int k = 0; k < n_rec; ++k)
+            if (receivers[k] == h) solution_.unshot[h] = results[k].field;
+    }
+    for (int i = 0; i < n; ++i) shot.unshot_after += unshot_power(i);
+    shot.seconds = now() - start;
+
+    SolveStats& st = solution_.stats;
+    ++st.shots;
+    st.unshot_power = shot.unshot_after;
+    st.kernel_evals += shot.kernel_evals;
+    st.rays += shot.rays;
+    st.per_shot.push_back(shot);
+    return shot;
+}
+
+std::vector<Rgb> ProgressiveSolver::ambient_correction() const {
+    // The power still unshot, U_j, and what it will become: X_i = U_i + rho_i sum_j F_ji X_j,
+    // with F_ji the measured fraction of j's shot power that reaches i (a surface that never
+    // shot spreads in proportion to the other surfaces' areas). Solved by Jacobi iteration
+    // (it converges: rho < 1 and each row of F sums to at most one). What surface i gains,
+    // rho_i sum_j F_ji X_j, is spread over its area as a constant radiosity.
+    const int n = static_cast<int>(scene_.surfaces.size());
+    std::vector<Rgb> U(n), rho(n);
+    std::vector<double> area(n);
+    double total_area = 0;
+    for (int i = 0; i < n; ++i) {
+        U[i] = power(i, solution_.unshot[i]);
+        rho[i] = scene_.material_of(i).reflectance.mean();
+        area[i] = scene_.surfaces[i].surface.area();
+        total_area += area[i];
+    }
+    auto coupling = [&](int j, int i) -> Rgb {
+        if (!coupling_[j].empty()) {
+            Rgb f;
+            for (int c = 0; c < 3; ++c)
+                f[c] = shot_power_[j][c] > 0 ? coupling_[j][i][c] / shot_power_[j][c] : 0.0;
+            return f;
+        }
+        const double f = i == j ? 0.0 : area[i] / (total_area - area[j]);
+        return {f, f, f};
+    };
+    std::vector<Rgb> X = U, gain(n);
+    for (int iteration = 0; iteration < 1000; ++iteration) {
+        double change = 0, size = 0;
+        for (int i = 0; i < n; ++i) {
+            Rgb arriving;
+            for (int j = 0; j < n; ++j) arriving += coupling(j, i) * X[j];
+            gain[i] = rho[i] * arriving;
+        }
+        for (int i = 0; i < n; ++i) {
+            const Rgb next = U[i] + gain[i];
+            change += max_abs(next - X[i]);
+            size += max_abs(next);
+            X[i] = next;
+        }
+        if (change <= 1e-12 * size) break;
+    }
+    std::vector<Rgb> correction(n);
+    for (int i = 0; i < n; ++i) correction[i] = area[i] > 0 ? (1 / area[i]) * gain[i] : Rgb{};
+    return correction;
+}
+
+Solution ProgressiveSolver::finish() {
+    Solution out = solution_;
+    SolveStats& st = out.stats;
+    if (options_.ambient) {
+        const std::vector<Rgb> correction = ambient_correction();
+        for (size_t i = 0; i < correction.size(); ++i) {
+            if (max_abs(correction[i]) == 0) continue;
+            out.radiosity[i].add(SplineField::constant(options_.receiver.m, 0, correction[i]));
+            st.ambient_power += channel_sum(correction[i]) * scene_.surfaces[i].surface.area();
+        }
+    }
+    st.seconds = now() - start_seconds_;
+    st.peak_memory_bytes = peak_memory_bytes();
+    double largest = 0;
+    for (int i = 0; i < int(scene_.surfaces.size()); ++i)
+        largest = std::max(largest, unshot_power(i));
+    st.converged = largest <= options_.convergence * st.emitted_power;
+    st.coefficients = 0;
+    for (const SplineField& f : out.radiosity)
+        if (!f.empty()) st.coefficients += long(f.channel(0).a.size());
+    // Each surface's final quadtree: the union of the trees it received (a cell is split when
+    // some transfer split it).
+    for (size_t i = 0; i < out.leaves.size(); ++i) {
+        const std::vector<std::uint64_t>& split = split_cells_[i];
+        std::vector<DyadicCell> leaves;
+        std::vector<DyadicCell> stack{{0, 0, 0}};
+        while (!stack.empty()) {
+            const DyadicCell c = stack.back();
+            stack.pop_back();
+            if (std::binary_search(split.begin(), split.end(), cell_key(c)))
+                for (int q = 3; q >= 0; --q) stack.push_back(c.child(q & 1, q >> 1));
+            else
+                leaves.push_back(c);
+        }
+        out.leaves[i] = std::move(leaves);
+    }
+    return out;
+}
+
+Solution solve(const Scene& scene, const Octree& octree, const SolverOptions& options,
+               const std::function<void(const ShotStats&, const ProgressiveSolver&)>& on_shot) {
+    ProgressiveSolver solver(scene, octree, options);
+    while (!solver.done()) {
+        const ShotStats shot = solver.shoot();
+        if (on_shot) on_shot(shot, solver);
+    }
+    return solver.finish();
+}
+
+}  // namespace mbr

@@ -1,0 +1,175 @@
+// radiosity/solver/solver.h - the radiosity of a whole scene by progressive refinement (paper section 4,
+// the algorithm box, and section 5 "Iteration"; DESIGN.md section 4).
+//
+//   for each emitting surface: project its emission; B = dB_unshot = E
+//   while not converged:
+//     shoot from the surface with the largest unshot power  int B_unshot A
+//     every surface that can receive from it gets dB by one transfer (radiosity/transfer/receiver.h),
+//       with shadows; B += dB, B_unshot += dB (SplineField::add)
+//     B_unshot of the shooter = 0
+//
+// Cost follows energy: every tolerance of a transfer is the larger of its relative value and
+// an absolute one in radiosity units, options.tolerance times the scene's radiosity scale
+// (emitted power / total area), so a shot that carries little power builds coarse trees,
+// coarse shooter partitions and casts few rays. The receivers of one shot run in parallel; the
+// solution does not depend on the number of threads.
+#pragma once
+
+#include <functional>
+#include <iosfwd>
+#include <string>
+#include <vector>
+
+#include "octree/octree.h"
+#include "radiosity/visibility/hidden_regions.h"
+#include "radiosity/geometry/quadtree.h"
+#include "radiosity/transfer/receiver.h"
+#include "radiosity/scene/scene.h"
+#include "radiosity/geometry/spline_field.h"
+
+namespace mbr {
+
+/// Options of the progressive loop and of its transfers.
+struct SolverOptions {
+    ReceiverOptions receiver;       // every transfer's options (order, depths, shadows, ...)
+    int max_shots = 100;            // stop after this many shots
+    double convergence = 1e-3;      // stop when the largest unshot power < this x emitted
+    bool self_transfer = false;     // concave curved surfaces receive from themselves
+    double tolerance = 2e-3;        // accuracy relative to the scene's radiosity scale: the
+                                    //   absolute tolerance of every transfer (see file comment)
+    double quadrature_share = 1;    // the quadrature's absolute tolerance, as a share of it
+    int emission_level = 5;         // level at which a textured emission is projected
+    bool hidden_regions = true;     // beyond the paper: samples at points that see no front
+                                    //   face take the nearest visible point's value
+                                    //   (radiosity/visibility/hidden_regions.h)
+    HiddenOptions hidden;           // how hidden points are found
+    int shooter_level = 3;          // a shooter's unshot field is coarsened to at most this
+                                    //   level (the paper's "lower resolution version", section
+                                    //   6); the receiver options' shooter_coarsening levels at
+                                    //   least (levels 4 and 5 measured: docs/method.md)
+    bool ambient = true;            // beyond the paper: at the end, the power still unshot is
+                                    //   sent on through the measured coupling of the surfaces
+                                    //   (the fraction of each shooter's power each receiver got,
+                                    //   over all its shots) and added as a constant radiosity per
+                                    //   surface (Cohen et al. 1988's ambient term, with measured
+                                    //   instead of area-weighted coupling)
+};
+
+/// The scene's `set` statements as solver options (shadows: the scene's method and rays).
+SolverOptions solver_options(const SolverSettings& settings);
+
+/// A surface b that lies in front of planar surface a's plane, but by no more than the plane
+/// tolerance of the receiver test (1e-9 of a's size): the solver treats it as lying on that
+/// plane, so no light passes between a and b (a light 1e-9 below a ceiling or above a floor).
+struct NearContact {
+    int a = -1, b = -1;  // surface indices
+    double gap = 0;      // how far b reaches in front of a's plane
+};
+/// The near contacts between each emitter and every other surface (O(emitters x surfaces)),
+/// found before solving so that programs can warn about them.
+std::vector<NearContact> near_contacts(const Scene& scene);
+
+/// One shot of the loop, measured.
+struct ShotStats {
+    int shot = 0;              // 1, 2, ...
+    int shooter = -1;          // surface index
+    double shooter_power = 0;  // its unshot power int B_unshot A (sum of channels) before
+    double unshot_before = 0;  // the scene's total unshot power before the shot
+    double unshot_after = 0;   //   and after
+    double reflected = 0;      // power the receivers reflect: sum_i int dB_i A
+    double incident = 0;       // power arriving: sum_i int dB_i A / rho_i (constant rho)
+    int receivers = 0;         // transfers made
+    long kernel_evals = 0;     // evaluations of (3) in all its transfers
+    long rays = 0;             // shadow rays
+    int finest_level = 0;      // finest level of its results
+    double seconds = 0;
+};
+
+/// The whole run.
+struct SolveStats {
+    int shots = 0;
+    double seconds = 0;
+    double emitted_power = 0;    // sum over emitters and channels of int E A
+    double unshot_power = 0;     // what remains unshot at the end (same units)
+    bool converged = false;      // the convergence test stopped the loop (not max_shots)
+    long peak_memory_bytes = 0;  // the process's peak resident memory
+    long coefficients = 0;       // coefficients of the solved fields (all surfaces, per channel)
+    long kernel_evals = 0, rays = 0;
+    double ambient_power = 0;     // power the ambient correction added (sum of channels)
+    std::vector<ShotStats> per_shot;
+};
+
+/// A solved scene: per surface (in scene order) its radiosity B (emission included) and what is
+/// still unshot, and the union of the receiver quadtrees each surface was given (leaves).
+struct Solution {
+    std::vector<SplineField> radiosity;
+    std::vector<SplineField> unshot;
+    std::vector<std::vector<DyadicCell>> leaves;
+    SolveStats stats;
+};
+
+/// The progressive loop, one shot at a time (for progress reports and tests).
+class ProgressiveSolver {
+public:
+    /// Projects the emission; the scene and octree must outlive the solver. The octree is the
+    /// one shadow rays use (build_octree(scene)).
+    ProgressiveSolver(const Scene& scene, const Octree& octree, const SolverOptions& options);
+    /// True when the convergence test or the shot limit says stop.
+    bool done() const;
+    /// One shot: from the surface with the largest unshot power to every surface that can
+    /// receive. Returns its statistics (also appended to solution().stats.per_shot).
+    ShotStats shoot();
+    /// The fields so far.
+    const Solution& solution() const { return solution_; }
+    /// The fields so far, with run statistics filled (seconds, memory, coefficients).
+    Solution finish();
+    /// The scene's radiosity scale: emitted power (the largest channel) / total area.
+    double radiosity_scale() const { return radiosity_scale_; }
+    /// Unshot power of surface i: int B_unshot A over its domain, summed over channels.
+    double unshot_power(int surface) const;
+
+private:
+    const Scene& scene_;
+    const Octree& octree_;
+    SolverOptions options_;
+    DualTable dual_;
+    Solution solution_;
+    std::vector<std::vector<std::uint64_t>> split_cells_;  // per surface: cells split in some tree
+    /// coupling_[j][i]: the power (per channel) surface i received from all of j's shots, and
+    /// shot_power_[j] the power j shot in them: their ratio is the measured fraction of j's
+    /// power that reaches i (empty until j shoots).
+    std::vector<std::vector<Rgb>> coupling_;
+    std::vector<Rgb> shot_power_;
+    /// The ambient correction of SolverOptions::ambient, per surface: a constant radiosity.
+    std::vector<Rgb> ambient_correction() const;
+    double radiosity_scale_ = 0;
+    double start_seconds_ = 0;
+    /// Power weights w_kl = int int N_k N_l A per surface and level (cached).
+    const std::vector<double>& power_weights(int surface, int level) const;
+    mutable std::vector<std::vector<std::vector<double>>> weights_;
+    std::vector<HiddenMask> hidden_;  // per surface (empty masks when the option is off)
+    std::vector<double> last_seconds_;  // per surface: its last transfer's seconds (scheduling)
+    Rgb power(int surface, const SplineField& field) const;
+};
+
+/// Solves the scene: shots until done(), calling on_shot (may be empty) after each.
+Solution solve(const Scene& scene, const Octree& octree, const SolverOptions& options,
+               const std::function<void(const ShotStats&, const ProgressiveSolver&)>& on_shot = {});
+
+/// The projection of a surface's emission: constant coefficients for a constant texture, else
+/// the L2 projection at `level` (Gauss-Legendre quadrature of the texture against the basis,
+/// then the Gram solve of math/wavelet.h's kind).
+SplineField project_emission(const Texture& emission, int m, int level);
+
+/// Solution files (docs/solution-format.md): a versioned text format holding each surface's
+/// name and both fields, with a fingerprint of the scene's surfaces. save_solution writes through
+/// `out`; load_solution refuses a damaged, truncated, foreign or mismatched file with an
+/// InputError naming `name` (the file) and the line.
+void save_solution(std::ostream& out, const Scene& scene, const Solution& solution);
+Solution load_solution(std::istream& in, const std::string& name, const Scene& scene);
+
+/// A fingerprint of the scene's surfaces and materials (names, kinds, corners, reflectance and
+/// emission means), for matching solution files to scenes.
+std::uint64_t scene_fingerprint(const Scene& scene);
+
+}  // namespace mbr

@@ -1,0 +1,233 @@
+// radiosity/transfer/sample_values.h - the kernel of the radiosity equation and the sample value of one energy
+// transfer (paper section 2, eqs. (2)-(4); section 4, eq. (21); section 6, "Adaptive
+// Quadrature"), and the analytic point-to-polygon form factor used as the exact reference
+// (section 7: "an analytic formula advocated in [7]", Baum, Rushmeier and Winget 1989).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <unordered_map>
+#include <vector>
+
+#include "math/convex2d.h"
+#include "math/gauss_legendre.h"
+#include "radiosity/visibility/visible_parts.h"
+#include "radiosity/geometry/spline_field.h"
+#include "radiosity/geometry/surface.h"
+
+namespace mbr {
+
+/// F(p, x) of eq. (3) for a receiving point p (normal n_p) and a shooting point x (normal n_x):
+/// [l . n_p][-l . n_x] / (pi |l|^4) with l = x - p, each cosine clamped at zero, so that a point
+/// behind either surface receives nothing (surfaces are one-sided).
+inline double form_factor_kernel(Vec3 p, Vec3 n_p, Vec3 x, Vec3 n_x) {
+    const Vec3 l = x - p;
+    const double cos_p = dot(l, n_p);   // |l| cos(theta_p)
+    const double cos_x = -dot(l, n_x);  // |l| cos(theta_x)
+    if (cos_p <= 0 || cos_x <= 0) return 0;
+    const double l2 = dot(l, l);
+    return cos_p * cos_x / (Pi * l2 * l2);
+}
+
+/// The form factor from a differential area at p (unit normal n_p) to a planar polygon, by
+/// Lambert's contour integral: F = |sum_i angle(R_i, R_{i+1}) n_p . unit(R_i x R_{i+1})| / (2 pi)
+/// with R_i = v_i - p. The polygon is one-sided like the surfaces: its front (counter-clockwise
+/// side) must face p, else F = 0. Parts behind p's tangent plane are clipped away first.
+/// Relative rounding error about eps r / s for a polygon of size s at distance r (the edge
+/// terms of order s / r cancel down to F), so a polygon 1e-9 of its distance keeps 7 digits.
+double point_polygon_form_factor(Vec3 p, Vec3 n_p, const std::vector<Vec3>& polygon);
+
+/// The shooting surface of one transfer and its unshot radiosity (already at the level the
+/// caller wants; section 6 coarsens it first).
+struct Shooter {
+    const Surface* surface = nullptr;
+    SplineField unshot;
+};
+
+/// Options of the adaptive quadrature of (21) over the shooter (section 6).
+struct QuadratureOptions {
+    int n = 6;                    // compare n x n with (n+1) x (n+1) Gauss-Legendre points
+    double rel_tolerance = 1e-4;  // allowed error relative to a first estimate of the integral
+    double abs_tolerance = 0;     // and never below this absolute error (the integral's units:
+                                  //   radiosity); a scene sets it from its accuracy, so a weak
+                                  //   shot's partitions stay coarse
+    int max_depth = 24;           // cap on the shooter's subdivision (at most 28)
+    int min_depth = 1;            // the whole shooter is never accepted as one cell
+    double min_share = 1e-6;      // floor of a cell's share of the tolerance (math/gauss_legendre.h)
+    double near_field = 4.0;      // split a cell whose extent exceeds near_field times its
+                                  //   distance from the receiving point (0: never)
+    bool global = false;          // refine the worst cell first until the error estimates sum
+                                  //   to the tolerance (AdaptiveOptions::global), instead of
+                                  //   the paper's quarter tolerance per child
+    bool analytic = true;         // a planar quad shooter of constant radiosity (an emitter's
+                                  //   first shot): I(p) by the contour formula over the
+                                  //   visible pieces, no quadrature (not when a partition is
+                                  //   asked for)
+    bool shadow_subtraction = true;  // planar shooters with occluders: the cells see only the
+                                  //   horizon, and the shadowed part (the union of the shadows
+                                  //   in front) is integrated on its own and subtracted; else
+                                  //   each cut cell's visible pieces are integrated
+    int n_pieces = 0;             // the rule pair on cut cells' pieces: n_pieces against
+                                  //   n_pieces + 1 points per triangle side (0: n, as cells)
+    int min_cut_level = 1;        // a cell the horizon or a shadow cuts is split down to this
+                                  //   level before its visible pieces are integrated (the
+                                  //   root's pieces would be many; deeper cells are split by
+                                  //   the error test when their pieces disagree)
+    bool subtract = true;         // planar quad shooters of varying radiosity: I(p) =
+                                  //   B_h(x*) F(p -> visible part) + int F (B_h - B_h(x*)),
+                                  //   the first term by the contour formula (x* the foot of p
+                                  //   on the shooter), so the peak of F near a receiving point
+                                  //   close to the shooter (surfaces that meet) is exact and the
+                                  //   remainder is nearly flat there
+    double near_field_subtracted = 0;  // the near-field guard when subtracting (0: off: the
+                                  //   remainder has no peak a cell's nodes could miss)
+    bool clip_horizon = true;     // planar shooters: integrate cells the receiving point's
+                                  //   tangent plane cuts over their front part only (exact
+                                  //   convex pieces), instead of chasing the kink of the
+                                  //   clamped cosine of (3) down to max_depth
+    int max_visibility_depth = 10;  // exact visibility on a curved shooter: cells whose nodes
+                                  //   disagree on visibility are split down to this level
+};
+
+/// One shooter point of the quadrature with everything that does not depend on the receiver:
+/// position, normal and e = w_a w_b J A_h(u,v) B_h(u,v) (Gauss-Legendre weights, the Jacobian
+/// J of the map from [-1,1]^2 to the cell, the area factor (4), the unshot radiosity).
+struct ShooterPoint {
+    Vec3 x;
+    Vec3 n;
+    Rgb e;
+    double a = 0;  // w_a w_b J A_h(u,v): e without B_h (for the singularity subtraction)
+};
+
+/// A triangle of the shadowed part of a shooter (shadow subtraction): fan triangle `fan` of the
+/// shadow region `region`, and three points in its barycentric coordinates (weights of its
+/// second and third corners), `level` halvings deep.
+struct ShadowTriangle {
+    int region = 0, fan = 1;
+    Vec2 bary[3];
+    int level = 0;
+    /// The four triangles of its edges' midpoints.
+    std::array<ShadowTriangle, 4> children() const {
+        const Vec2 ab = 0.5 * (bary[0] + bary[1]), bc = 0.5 * (bary[1] + bary[2]), ca = 0.5 * (bary[2] + bary[0]);
+        return {ShadowTriangle{region, fan, {bary[0], ab, ca}, level + 1},
+                ShadowTriangle{region, fan, {ab, bary[1], bc}, level + 1},
+                ShadowTriangle{region, fan, {ca, bc, bary[2]}, level + 1},
+                ShadowTriangle{region, fan, {ab, bc, ca}, level + 1}};
+    }
+    bool operator<(const ShadowTriangle& o) const {
+        if (region != o.region) return region < o.region;
+        if (fan != o.fan) return fan < o.fan;
+        if (level != o.level) return level < o.level;
+        for (int k = 0; k < 3; ++k) {
+            if (bary[k].x != o.bary[k].x) return bary[k].x < o.bary[k].x;
+            if (bary[k].y != o.bary[k].y) return bary[k].y < o.bary[k].y;
+        }
+        return false;
+    }
+};
+
+/// The integral of eq. (21) without the receiver's reflectance:
+///   I(p) = int_{[0,1]^2} F(p, x_h(u,v)) VIS B_h(u,v) A_h(u,v) du dv,
+/// by the adaptive rule of section 6 (n against n + 1 points per cell, split in four with a
+/// quarter of the tolerance). VIS = 1 unless an occlusion context is given (exact visibility,
+/// radiosity/visibility/visible_parts.h): then a planar shooter's cells are clipped to what p sees, and a curved
+/// shooter's nodes each cast a ray. Shooter points are cached per dyadic cell, so one
+/// integrator per thread: the cache changes speed, never values, so results do not depend on
+/// thread count.
+class IncrementIntegrator {
+public:
+    IncrementIntegrator(const Shooter& shooter, const QuadratureOptions& options,
+                        const OcclusionContext* occlusion = nullptr);
+
+    struct Result {
+        Rgb value;
+        long n_evaluations = 0;   // kernel evaluations
+        long n_rays = 0;          // visibility rays (exact visibility on a curved shooter)
+        Rgb subtracted;           // B_h(x*) when the singularity was subtracted (the partition's
+                                  //   cell values are then those of the remainder)
+        bool shadow_subtracted = false;  // the shadowed part was integrated on its own
+        std::vector<ShadowTriangle> shadow_triangles;  // its triangles (integrate_on reuses them)
+        std::vector<int> shadow_shape;  // the vertex count of each shadow region they refer to
+        double shadow_tolerance = 0;    // the tolerance the shadowed part was integrated to,
+        double shadow_near_field = 0;   //   and its near-field guard
+        bool converged = true;
+        std::vector<AcceptedCell<Rgb>> partition;  // the shooter's cells, when asked for
+    };
+    /// I(p) by the adaptive rule; the shooter partition is kept when keep_partition is set
+    /// (the shadow stage casts rays to its cells; edgefill reuses it for divided differences).
+    /// min_depth >= 0 overrides the options' smallest depth of the partition.
+    Result integrate(const SurfacePoint& p, bool keep_partition = false, int min_depth = -1,
+                     bool allow_subtraction = true);
+    /// I(p) on a given partition with the (n+1)-point rule on each cell: the same quadrature
+    /// error pattern as the run that made the partition, so divided differences (22) of nearby
+    /// points are not swamped by it. `made_by`, the result that made the partition, says
+    /// whether (and what) it subtracted: the same constant is subtracted here.
+    Rgb integrate_on(const SurfacePoint& p, const std::vector<AcceptedCell<Rgb>>& partition,
+                     long* n_evaluations, long* n_rays = nullptr, const Result* made_by = nullptr);
+    /// The points of a cell for the n-point rule (cached): n*n points from `first`, valid until
+    /// the next call.
+    struct PointSpan {
+        const ShooterPoint* first;
+        int count;
+    };
+    PointSpan points(const QuadCell& cell, int n);
+    /// The shooter's plane when it is a planar quad, else null.
+    const ShooterPlane* shooter_plane() const { return planar_ ? &plane_ : nullptr; }
+    /// True when integrate() uses the closed form (QuadratureOptions::analytic).
+    bool analytic() const { return analytic_; }
+    /// Every receiving point lies on this plane (a planar receiver): the horizon is one line,
+    /// and the points of the cells it cuts are cached like the others.
+    void set_receiver_plane(const Plane& plane) { receiver_plane_ = plane; }
+
+private:
+    Rgb sum_over(const SurfacePoint& p, PointSpan pts) const;
+    /// The visible part's form factor from p by the contour formula (after set_view).
+    double visible_form_factor(const SurfacePoint& p);
+    /// The n x n rule on one cell as p sees it (the view of the last set_view): cached points
+    /// for a clear cell, zero for a hidden one, convex pieces for a cut one; per-node rays on
+    /// a curved shooter with an occlusion context.
+    Rgb cell_value(const SurfacePoint& p, const QuadCell& cell, int n);
+    void set_view(const SurfacePoint& p);
+    ConvexPolygon cell_image(const QuadCell& cell) const;
+    Rgb pieces_value(const SurfacePoint& p, const std::vector<ConvexPolygon>& pieces, int n);
+    Rgb triangle_value(const SurfacePoint& p, Vec2 a, Vec2 b, Vec2 c, int n);
+    /// int F (B_h - b*) over the shadowed part (shadow_regions_) to `tolerance`, adaptively
+    /// over its fan triangles; the triangles kept are appended to *kept.
+    Rgb shadow_integral(const SurfacePoint& p, double tolerance, double near_field,
+                        std::vector<ShadowTriangle>* kept);
+    /// The same on given triangles (those another point kept), with the n + 1 rule.
+    Rgb shadow_on(const SurfacePoint& p, const std::vector<ShadowTriangle>& triangles);
+    std::vector<ConvexPolygon> shadow_regions_;  // disjoint convex parts of the shadows in front
+    void take_shadows_apart();  // view_'s shadows -> shadow_regions_ (then view_ has none)
+
+    const Shooter& shooter_;
+    QuadratureOptions options_;
+    const OcclusionContext* occlusion_ = nullptr;  // exact visibility when set (and not clear)
+    bool planar_ = false;               // the shooter is a planar quad: exact clipping works
+    bool analytic_ = false;             // and of constant radiosity: closed form
+    ShooterPlane plane_;                // its frame
+    BlockedView view_;                  // what the current point cannot see
+    std::vector<TriangleRule> tri_rules_;  // tri_rules_[n]
+    long extra_evaluations_ = 0;        // kernel evaluations on cut pieces (current point)
+    long rays_ = 0;                     // rays cast for the current point
+    Rgb b_star_;                        // the constant subtracted from B_h (zero: none)
+    std::vector<int> local_;            // scratch: the occluders of one cell's shaft
+    std::vector<std::uint64_t> mixed_;  // cells whose nodes disagreed on visibility (curved), or
+                                        //   cut cells above min_cut_level (planar): split
+    std::uint64_t pieces_key_ = ~0ULL;  // the cut cell whose pieces are in pieces_
+    std::vector<ConvexPolygon> pieces_;
+    PolynomialPatches unshot_patches_;  // B_h for scattered points (cut pieces)
+    std::optional<Plane> receiver_plane_;  // set_receiver_plane
+    /// The front pieces' points of cells only the (fixed) horizon cuts, per cell and rule.
+    std::unordered_map<std::uint64_t, std::vector<ShooterPoint>> horizon_cache_;
+    PointSpan horizon_points(const QuadCell& cell, int n, const ConvexPolygon& image);
+    std::vector<GaussLegendre> rules_;  // rules_[n]
+    std::vector<ShooterPoint> pool_;    // every cached cell's points, one after the other
+    std::vector<Rgb> unshot_values_;    // scratch: B_h on one cell's grid
+    std::unordered_map<std::uint64_t, std::uint32_t> cache_;  // cell key -> offset in pool_
+    double unshot_bound_ = 0;           // max |B_h| bound: the largest coefficient
+    bool unshot_constant_ = false;      // B_h is one constant (an emitter's first shot)
+};
+
+}  // namespace mbr

@@ -1,0 +1,343 @@
+// radiosity/transfer/shadows.cpp - stage 7 of one transfer, the paper's shadows: visible fractions
+// (28) at fulcrums, shadow subdivision, and masking of the coefficients (section 5 "Adaptive
+// Subdivision in Shadow Computation", section 6 "Shadow"; DESIGN.md section 3, stage 7).
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <optional>
+#include <cstring>
+#include <set>
+
+#include "math/check.h"
+#include "math/parallel.h"
+#include "radiosity/transfer/receiver.h"
+
+namespace mbr {
+
+namespace {
+
+std::uint64_t bits(double x) {
+    std::uint64_t b;
+    std::memcpy(&b, &x, sizeof b);
+    return b;
+}
+
+/// The size of the finest domain leaf.
+double finest_domain_leaf(const Forest& forest) {
+    double h = 1;
+    for (int index : forest.leaves(Forest::Region::Domain))
+        h = std::min(h, forest.node(index).cell.size());
+    return h;
+}
+
+/// The depth of a fraction's shooter partition, following energy. 4^d patches of R rays each
+/// estimate (28) with a standard error of at most 1 / (2 sqrt(4^d R)); times the largest sample
+/// S of the shot, that error must stay below the scene's absolute tolerance tau: 4^d R >=
+/// (S / (2 tau))^2. Never deeper than min_patch_depth (the paper's fixed partition), never
+/// shallower than 1 (four patches).
+int patch_depth(const ReceiverState& state) {
+    const ShadowOptions& so = state.options.shadows;
+    const double tau = state.options.absolute_tolerance;
+    if (tau <= 0 || state.max_sample <= 0) return so.min_patch_depth;
+    const double needed = std::pow(state.max_sample / (2 * tau), 2) / so.rays_per_patch;
+    int d = 1;
+    while (d < so.min_patch_depth && std::pow(4.0, d) < needed) ++d;
+    return std::min(d, so.min_patch_depth);
+}
+
+/// Eq. (28) at the domain point (s, t), computed (no memo): rays to random points of every
+/// patch of the shooter partition that (21)'s adaptive quadrature forms there.
+Rgb compute_fraction(const ReceiverState& state, IncrementSampler& sampler, Vec2 point,
+                     double inset, int thread, long* n_rays, long* n_evals) {
+    const OcclusionContext& ctx = *state.occlusion;
+    // DESIGN: a point of the domain's boundary is moved `inset` inside (boundary_inset of the
+    // finest leaf, as edgefill does): on an edge shared with the shooter the kernel is singular.
+    const double s = std::clamp(point.x, inset, 1 - inset),
+                 t = std::clamp(point.y, inset, 1 - inset);
+    const SurfacePoint p = sampler.receiver().surface->evaluate(s, t);
+    IncrementIntegrator& integrator = sampler.integrator(thread);
+    // DESIGN: beyond the paper, the rays of a point are tested only against the occluders that
+    // meet its pyramid to a planar shooter; when there are none the fraction is 1 without a ray
+    // (what the rays would give, to the bit) and without the partition's kernel evaluations.
+    std::vector<int> toward;
+    const ShooterPlane* plane = integrator.shooter_plane();
+    if (plane) {
+        // More than max_listed_occluders: the rays go through the octree, so the list need
+        // not be complete (the pyramid from a ceiling point to the floor holds the whole room).
+        toward = occluders_toward(ctx, *plane, p.position, max_listed_occluders);
+        if (toward.empty()) return {1, 1, 1};
+    }
+    const IncrementIntegrator::Result r =
+        integrator.integrate(p, true, patch_depth(state), false);
+    *n_evals += r.n_evaluations;
+    const int n_rays_per_patch = state.options.shadows.rays_per_patch;
+    const Surface& shooter = *sampler.shooter().surface;
+    // DESIGN: the rays of a point are seeded from its position (a fulcrum's (level, k, l) in
+    // lowest terms: two fulcrums at one point share the fraction), the pair and the shot.
+    const std::uint64_t point_key = hash_seed(ctx.seed, bits(point.x), bits(point.y));
+    Rgb num, den;
+    for (size_t i = 0; i < r.partition.size(); ++i) {
+        const AcceptedCell<Rgb>& patch = r.partition[i];
+        const Rgb e = patch.value;  // energy the patch shoots toward p
+        if (max_abs(e) == 0) continue;
+        const std::uint64_t key = hash_seed(point_key, i);
+        int visible = 0;
+        // DESIGN: when the count is a square, the random points are jittered on a grid of as
+        // many strata (2 x 2 for the default 4): still uniform over the patch, less variance.
+        const int side = static_cast<int>(std::lround(std::sqrt(double(n_rays_per_patch))));
+        const bool strata = side * side == n_rays_per_patch;
+        for (int k = 0; k < n_rays_per_patch; ++k) {
+            const Rect& c = patch.cell.rect;
+            double a = uniform01(key, 2 * k), b = uniform01(key, 2 * k + 1);
+            if (strata) {
+                a = (k % side + a) / side;
+                b = (k / side + b) / side;
+            }
+            const Vec3 x = shooter.point(c.x0 + a * c.width(), c.y0 + b * c.height());
+            const bool blocked = plane ? segment_blocked(ctx, toward, p.position, x, n_rays)
+                                       : segment_blocked(ctx, p.position, x, n_rays);
+            if (!blocked) ++visible;
+        }
+        num += (double(visible) / n_rays_per_patch) * e;
+        den += e;
+    }
+    Rgb f;
+    for (int c = 0; c < 3; ++c) f[c] = den[c] > 0 ? std::clamp(num[c] / den[c], 0.0, 1.0) : 1.0;
+    return f;
+}
+
+/// Fractions at the given points that are not known yet, computed in parallel and memoised.
+void compute_fractions(ReceiverState& state, IncrementSampler& sampler, std::vector<Vec2> points,
+                       double inset) {
+    std::sort(points.begin(), points.end(),
+              [](Vec2 a, Vec2 b) { return a.x != b.x ? a.x < b.x : a.y < b.y; });
+    points.erase(std::unique(points.begin(), points.end(),
+                             [](Vec2 a, Vec2 b) { return a.x == b.x && a.y == b.y; }),
+                 points.end());
+    std::vector<Vec2> todo;
+    for (Vec2 q : points)
+        if (!state.fractions.count({q.x, q.y})) todo.push_back(q);
+    const int n = static_cast<int>(todo.size());
+    std::vector<Rgb> values(n);
+    std::vector<long> rays(n, 0), evals(n, 0);
+    parallel_for(n, [&](int i) {
+        values[i] =
+            compute_fraction(state, sampler, todo[i], inset, thread_index(), &rays[i], &evals[i]);
+    });
+    for (int i = 0; i < n; ++i) {
+        state.fractions[{todo[i].x, todo[i].y}] = values[i];
+        state.stats.n_rays += rays[i];
+        state.stats.n_kernel_evals += evals[i];
+    }
+    state.stats.n_fractions += n;
+}
+
+/// The fulcrums of a leaf at its own scale (Figure 2): its corners for even m, its centre for
+/// odd m.
+std::vector<Fulcrum> leaf_fulcrums(const DyadicCell& c, int m) {
+    std::vector<Fulcrum> out;
+    if (m % 2 == 1) {
+        out.push_back({c.level, c.i - (m - 1) / 2, c.j - (m - 1) / 2});
+    } else {
+        for (int b = 0; b <= 1; ++b)
+            for (int a = 0; a <= 1; ++a) out.push_back({c.level, c.i + a - m / 2, c.j + b - m / 2});
+    }
+    return out;
+}
+
+/// The bilinear interpolation, at a point of the domain, of the fractions at the corners of the
+/// domain leaf holding it (the point's own fraction when it has one); nothing when a corner's
+/// fraction is unknown.
+std::optional<Rgb> interpolated_fraction(const ReceiverState& state, Vec2 q) {
+    const auto own = state.fractions.find({q.x, q.y});
+    if (own != state.fractions.end()) return own->second;
+    // Points on the domain's upper edges belong to its last cells (not to a ring cell).
+    const double below_one = std::nextafter(1.0, 0.0);
+    const int leaf = state.forest.leaf_at(std::min(q.x, below_one), std::min(q.y, below_one));
+    if (leaf < 0) return std::nullopt;
+    const Rect r = state.forest.node(leaf).cell.rect();
+    Rgb corner[4];
+    const double xs[2] = {r.x0, r.x1}, ys[2] = {r.y0, r.y1};
+    for (int k = 0; k < 4; ++k) {
+        const auto it = state.fractions.find({xs[k & 1], ys[k >> 1]});
+        if (it == state.fractions.end()) return std::nullopt;
+        corner[k] = it->second;
+    }
+    const double a = (q.x - r.x0) / r.width(), b = (q.y - r.y0) / r.height();
+    return (1 - a) * (1 - b) * corner[0] + a * (1 - b) * corner[1] + (1 - a) * b * corner[2] +
+           a * b * corner[3];
+}
+
+double difference(Rgb a, Rgb b) {
+    return max_abs(a - b);
+}
+
+}  // namespace
+
+Vec2 fraction_point(const Fulcrum& f, int m) {
+    const Vec2 c = f.position(m);
+    return {std::clamp(c.x, 0.0, 1.0), std::clamp(c.y, 0.0, 1.0)};
+}
+
+Rgb fraction_at(ReceiverState& state, IncrementSampler& sampler, double s, double t, int thread) {
+    auto it = state.fractions.find({s, t});
+    if (it != state.fractions.end()) return it->second;
+    if (!state.occlusion) return {1, 1, 1};
+    long rays = 0, evals = 0;
+    const double inset = state.options.boundary_inset * finest_domain_leaf(state.forest);
+    const Rgb f = compute_fraction(state, sampler, {s, t}, inset, thread, &rays, &evals);
+    state.fractions[{s, t}] = f;
+    state.stats.n_rays += rays;
+    state.stats.n_kernel_evals += evals;
+    ++state.stats.n_fractions;
+    return f;
+}
+
+void apply_shadows(ReceiverState& state, IncrementSampler& sampler, const DualTable& dn) {
+    if (!state.occlusion) return;
+    const ReceiverOptions& opt = state.options;
+    const ShadowOptions& so = opt.shadows;
+    const int m = opt.m;
+    Forest& forest = state.forest;
+    const double inset = opt.boundary_inset * finest_domain_leaf(forest);
+    // Fractions that differ by more than the threshold split, unless the difference they make
+    // is below the scene's absolute tolerance (a weak shot keeps coarse shadows).
+    const double threshold = std::max(so.threshold, state.max_sample > 0 ? opt.absolute_tolerance / state.max_sample : 0.0);
+
+    std::set<int> new_leaves;  // domain leaves made by shadow subdivision (node indices)
+    for (;;) {
+        // Fractions at every domain leaf's fulcrums.
+        const std::vector<int> leaves = forest.leaves(Forest::Region::Domain);
+        std::vector<Vec2> points;
+        for (int index : leaves)
+            for (const Fulcrum& f : leaf_fulcrums(forest.node(index).cell, m))
+                points.push_back(fraction_point(f, m));
+        compute_fractions(state, sampler, points, inset);
+        auto phi = [&](const Fulcrum& f) {
+            const Vec2 q = fraction_point(f, m);
+            return state.fractions.at({q.x, q.y});
+        };
+
+        // "If the fraction corresponding to two adjacent fulcrums differs significantly, the
+        // corresponding subdomains are subdivided."
+        std::set<int> marked;
+        for (int index : leaves) {
+            const DyadicCell c = forest.node(index).cell;
+            if (m % 2 == 0) {
+                // Adjacent fulcrums: the two ends of each edge of the leaf.
+                const std::vector<Fulcrum> f = leaf_fulcrums(c, m);  // (0,0) (1,0) (0,1) (1,1)
+                const int edges[4][2] = {{0, 1}, {1, 3}, {3, 2}, {2, 0}};
+                for (const auto& e : edges)
+                    if (difference(phi(f[e[0]]), phi(f[e[1]])) > threshold) {
+                        marked.insert(index);
+                        if (c.level < so.max_depth) {
+                            state.split_fulcrums.push_back(fraction_point(f[e[0]], m));
+                            state.split_fulcrums.push_back(fraction_point(f[e[1]], m));
+                        }
+                    }
+            } else {
+                // Adjacent fulcrums: the centres of leaves sharing an edge (each pair is seen
+                // from its finer leaf, or from both when they are of one size).
+                const Fulcrum own = leaf_fulcrums(c, m)[0];
+                const Rect r = c.rect();
+                const double d = 0.25 * c.size();
+                const Vec2 across[4] = {{r.x0 - d, 0.5 * (r.y0 + r.y1)},
+                                        {r.x1 + d, 0.5 * (r.y0 + r.y1)},
+                                        {0.5 * (r.x0 + r.x1), r.y0 - d},
+                                        {0.5 * (r.x0 + r.x1), r.y1 + d}};
+                for (const Vec2& q : across) {
+                    if (q.x < 0 || q.x > 1 || q.y < 0 || q.y > 1) continue;
+                    const int other = forest.leaf_at(q.x, q.y);
+                    if (other < 0 || forest.node(other).cell.level > c.level) continue;
+                    const Fulcrum of = leaf_fulcrums(forest.node(other).cell, m)[0];
+                    if (!state.fractions.count({fraction_point(of, m).x, fraction_point(of, m).y}))
+                        continue;  // a leaf of an earlier round's scale adjustment: next round
+                    if (difference(phi(own), phi(of)) > threshold) {
+                        marked.insert(index);
+                        marked.insert(other);
+                        state.split_fulcrums.push_back(fraction_point(own, m));
+                        state.split_fulcrums.push_back(fraction_point(of, m));
+                    }
+                }
+            }
+        }
+        std::vector<int> to_split;
+        for (int index : marked)
+            if (forest.node(index).cell.level < so.max_depth) to_split.push_back(index);
+        if (to_split.empty()) break;
+        for (int index : to_split) {
+            if (!forest.node(index).is_leaf()) continue;
+            forest.split(index);
+            ++state.stats.n_shadow_splits;
+        }
+        // "Here, the scale of adjacent subdomains is also adjusted."
+        state.stats.n_shadow_splits += adjust_neighbour_scales(forest, Forest::Region::All);
+        sample_split_leaves(state);
+        for (int index : forest.leaves(Forest::Region::Domain))
+            if (forest.node(index).resampled) new_leaves.insert(index);
+    }
+
+    // Projections on demand may now reach finer leaves: resampling tables for every level.
+    if (!new_leaves.empty()) {
+        int finest = 0;
+        for (int index = 0; index < forest.n_nodes(); ++index)
+            finest = std::max(finest, forest.node(index).cell.level);
+        state.tables = std::make_shared<const ProjectionTables>(
+            make_projection_tables(m, dn, state.rhombus_radius, finest));
+    }
+
+    // The new leaves' fulcrums: coefficients carried from the coarser ones by (17) ("During
+    // subdivision, (17) is applied to those projection coefficients computed in the previous
+    // section to obtain projection coefficients at a smaller scale").
+    std::set<Fulcrum> added;
+    for (int index : new_leaves) {
+        if (!forest.node(index).is_leaf()) continue;
+        for (const Fulcrum& f : leaf_fulcrums(forest.node(index).cell, m))
+            if (!state.coefficients.count(f)) added.insert(f);
+    }
+    std::map<Fulcrum, Rgb> refined;
+    for (const Fulcrum& f : added) {
+        state.fulcrums.push_back(f);
+        if (!opt.unify_by_projection) {
+            const Rgb c = resolve_coefficient(state, dn, f, refined);
+            state.coefficients[f] = c;
+        }
+    }
+    std::sort(state.fulcrums.begin(), state.fulcrums.end());
+    state.fulcrums.erase(std::unique(state.fulcrums.begin(), state.fulcrums.end()),
+                         state.fulcrums.end());
+    state.stats.n_fulcrums = static_cast<int>(state.fulcrums.size());
+
+    // "After subdivision, each resulting coefficient is multiplied by its corresponding
+    // fraction." An expanded fulcrum takes the fraction of the nearest point of the domain.
+    std::vector<Vec2> points;
+    for (const auto& [f, c] : state.coefficients) points.push_back(fraction_point(f, m));
+    // Stage 8 will project every finest-scale coefficient (unify_by_projection). For odd m
+    // their fractions are computed, in parallel now. DESIGN: for even m a fine fulcrum inside a
+    // leaf takes the bilinear interpolation of the fractions at the leaf's corners (its own
+    // fulcrums): the leaf was not split, so those fractions differ by less than the threshold
+    // (or the leaf is at max_depth) and the fraction varies less than that inside it. Computing
+    // (28) at every fine fulcrum instead cast 4225 x 256 rays per receiver at level 6.
+    const bool interpolate = opt.unify_by_projection && m % 2 == 0;
+    if (opt.unify_by_projection && !interpolate) {
+        int j = 0;
+        for (const Fulcrum& f : state.fulcrums) j = std::max(j, f.level);
+        const int first = first_touching_index(m), n = touching_count(m, j);
+        for (int k = first; k < first + n; ++k)
+            for (int l = first; l < first + n; ++l) points.push_back(fraction_point({j, k, l}, m));
+    }
+    compute_fractions(state, sampler, points, inset);
+    for (auto& [f, c] : state.coefficients) {
+        const Vec2 q = fraction_point(f, m);
+        c = c * state.fractions.at({q.x, q.y});
+    }
+    state.mask = [&state, &sampler, m, interpolate](const Fulcrum& f) {
+        const Vec2 q = fraction_point(f, m);
+        if (interpolate) {
+            if (const std::optional<Rgb> r = interpolated_fraction(state, q)) return *r;
+        }
+        return fraction_at(state, sampler, q.x, q.y, 0);
+    };
+}
+
+}  // namespace mbr

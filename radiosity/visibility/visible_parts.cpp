@@ -1,0 +1,551 @@
+// radiosity/visibility/visible_parts.cpp - occluders of a pair, shadow rays, and the exact visible part of a
+// planar shooter (the geometry of radiosity/visibility/visible_parts.h). The fractions (28) and the shadow
+// subdivision of stage 7 are in shadow_stage.cpp.
+#include "radiosity/visibility/visible_parts.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "math/check.h"
+
+namespace mbr {
+
+// ---- Seeds -------------------------------------------------------------------------------
+
+namespace {
+std::uint64_t splitmix(std::uint64_t x) {
+    x += 0x9e3779b97f4a7c15ULL;
+    x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ULL;
+    x = (x ^ (x >> 27)) * 0x94d049bb133111ebULL;
+    return x ^ (x >> 31);
+}
+}  // namespace
+
+std::uint64_t hash_seed(std::uint64_t a, std::uint64_t b, std::uint64_t c, std::uint64_t d) {
+    return splitmix(splitmix(splitmix(splitmix(a) ^ b) ^ c) ^ d);
+}
+
+double uniform01(std::uint64_t key, std::uint64_t index) {
+    return double(hash_seed(key, index) >> 11) * 0x1.0p-53;
+}
+
+// ---- Occluders of a pair -----------------------------------------------------------------
+
+std::vector<Vec3> hull_points(const Surface& surface) {
+    if (surface.kind() == Surface::Kind::PlanarQuad) {
+        const Vec3* c = surface.corners();
+        return {c[0], c[1], c[2], c[3]};
+    }
+    const Box3 b = surface.bounds();
+    std::vector<Vec3> out;
+    for (int i = 0; i < 8; ++i)
+        out.push_back(
+            {(i & 1) ? b.hi.x : b.lo.x, (i & 2) ? b.hi.y : b.lo.y, (i & 4) ? b.hi.z : b.lo.z});
+    return out;
+}
+
+namespace {
+
+/// An outward plane n . x <= d of a convex hull.
+struct HullPlane {
+    Vec3 n;
+    double d;
+};
+
+/// The supporting planes of the convex hull of a few points: every plane through three of them
+/// with all the others on its inner side (a flat hull gets its plane in both orientations).
+/// Brute force, for the 8 to 16 points of two surfaces.
+std::vector<HullPlane> hull_planes(const std::vector<Vec3>& pts, double tol) {
+    std::vector<HullPlane> planes;
+    const int n = static_cast<int>(pts.size());
+    for (int a = 0; a < n; ++a)
+        for (int b = a + 1; b < n; ++b)
+            for (int c = b + 1; c < n; ++c) {
+                Vec3 normal = cross(pts[b] - pts[a], pts[c] - pts[a]);
+                const double len = length(normal);
+                if (len <= tol * tol) continue;  // (nearly) collinear
+                normal = normal / len;
+                for (double sign : {1.0, -1.0}) {
+                    const Vec3 nn = sign * normal;
+                    const double d = dot(nn, pts[a]);
+                    bool supporting = true;
+                    for (const Vec3& q : pts)
+                        if (dot(nn, q) - d > tol) {
+                            supporting = false;
+                            break;
+                        }
+                    if (supporting) planes.push_back({nn, d});
+                }
+            }
+    return planes;
+}
+
+}  // namespace
+
+OcclusionContext make_occlusion_context(const Octree& octree, const Surface& shooter,
+                                        int shooter_surface, const Surface& receiver,
+                                        int receiver_surface, std::uint64_t shot) {
+    OcclusionContext ctx;
+    ctx.octree = &octree;
+    ctx.shooter_surface = shooter_surface;
+    ctx.receiver_surface = receiver_surface;
+    ctx.seed = hash_seed(std::uint64_t(shooter_surface), std::uint64_t(receiver_surface), shot);
+
+    std::vector<Vec3> pts = hull_points(shooter);
+    for (const Vec3& q : hull_points(receiver)) pts.push_back(q);
+    Box3 hull_box;
+    double scale = 0;
+    for (const Vec3& q : pts) {
+        hull_box.extend(q);
+        scale = std::max({scale, std::fabs(q.x), std::fabs(q.y), std::fabs(q.z)});
+    }
+    scale = std::max(scale, length(hull_box.extent()));
+    // DESIGN: 1e-9 of the coordinates: points that far off a hull plane count as on it, and a
+    // polygon that only touches the hull's boundary cannot block a segment inside it.
+    const double tol = 1e-9 * scale;
+    const std::vector<HullPlane> planes = hull_planes(pts, tol);
+
+    auto box_outside = [&](const Box3& box) {
+        if (!overlaps(box, hull_box)) return true;
+        for (const HullPlane& h : planes) {
+            // The corner furthest inside: all eight corners outside when even it is.
+            const Vec3 inner{h.n.x > 0 ? box.lo.x : box.hi.x, h.n.y > 0 ? box.lo.y : box.hi.y,
+                             h.n.z > 0 ? box.lo.z : box.hi.z};
+            if (dot(h.n, inner) - h.d > tol) return true;
+        }
+        return false;
+    };
+    // DESIGN: a polygon lying on a planar receiver (every vertex in front of its plane by at
+    // most 1e-3 of the receiver's size: a light hung a hair below the ceiling, a rug on the
+    // floor) is no occluder of that receiver. It can only block rays that leave the receiver
+    // within 1e-3 of grazing, whose kernel (3) carries a cosine below 1e-3, except under its
+    // footprint, which sees nothing anyway (hidden regions, radiosity/visibility/hidden_regions.h). Kept, its
+    // shadow seen from a receiving point is a sliver along the horizon whose shape rounding
+    // decides: the kind of shadow that made edgefill's divided differences (22) thousands of
+    // times too steep (IncrementIntegrator::take_shadows_apart).
+    const std::optional<Plane> receiver_plane = surface_plane(receiver);
+    const double lying = 1e-3 * length(receiver.bounds().extent());
+    auto lies_on_receiver = [&](const Polygon& poly) {
+        if (!receiver_plane) return false;
+        for (const Vec3& v : poly.vertices()) {
+            const double h = dot(receiver_plane->normal, v) - receiver_plane->offset;
+            if (h < -tol || h > lying) return false;
+        }
+        return true;
+    };
+    const std::vector<int> near =
+        octree.polygons_near([&](const Box3& cube) { return !box_outside(cube); });
+    for (int id : near) {
+        const Polygon& poly = octree.polygons()[id];
+        if (poly.surface() == shooter_surface || poly.surface() == receiver_surface) continue;
+        if (box_outside(poly.bounds())) continue;
+        if (lies_on_receiver(poly)) continue;
+        bool outside = false;
+        for (const HullPlane& h : planes) {
+            bool all_out = true;
+            for (const Vec3& v : poly.vertices())
+                if (dot(h.n, v) - h.d < -tol) {
+                    all_out = false;
+                    break;
+                }
+            if (all_out) {
+                outside = true;
+                break;
+            }
+        }
+        if (outside) continue;
+        // The polygon's own plane may separate: every hull point strictly on one side.
+        const Plane& pl = poly.plane();
+        bool pos = false, neg = false;
+        for (const Vec3& q : pts) {
+            const double s = pl.signed_distance(q);
+            if (s > tol) pos = true;
+            if (s < -tol) neg = true;
+        }
+        if (pos != neg) continue;  // one side only (or touching): the hull's inside is clear
+        ctx.candidates.push_back(id);
+    }
+    return ctx;
+}
+
+bool segment_blocked(const OcclusionContext& context, Vec3 a, Vec3 b, long* n_rays) {
+    if (context.candidates.empty()) return false;
+    if (n_rays) ++*n_rays;
+    // DESIGN: the open segment, t in [1e-9, 1 - 1e-9]: the end points lie on the two surfaces,
+    // which never block their own transfer anyway (their polygons are skipped).
+    const Ray ray{a, b - a, 1e-9, 1 - 1e-9};
+    if (context.candidates.size() <= 16) {
+        const std::vector<Polygon>& polys = context.octree->polygons();
+        for (int id : context.candidates)
+            if (polys[id].intersect(ray)) return true;
+        return false;
+    }
+    return context.octree->any_hit(ray,
+                                   RayFilter{context.shooter_surface, context.receiver_surface});
+}
+
+bool segment_blocked(const OcclusionContext& context, const std::vector<int>& occluders, Vec3 a,
+                     Vec3 b, long* n_rays) {
+    if (occluders.empty()) return false;
+    // DESIGN: up to 32 occluders are tested one by one; beyond, the octree is faster.
+    if (occluders.size() > max_listed_occluders) return segment_blocked(context, a, b, n_rays);
+    if (n_rays) ++*n_rays;
+    const Ray ray{a, b - a, 1e-9, 1 - 1e-9};
+    const std::vector<Polygon>& polys = context.octree->polygons();
+    for (int id : occluders)
+        if (polys[id].intersect(ray)) return true;
+    return false;
+}
+
+// ---- The visible part of a planar shooter ------------------------------------------------
+
+Vec2 ShooterPlane::at(double u, double v) const {
+    return (1 - u) * (1 - v) * corner[0] + u * (1 - v) * corner[1] + u * v * corner[2] +
+           (1 - u) * v * corner[3];
+}
+
+ShooterPlane make_shooter_plane(const Surface& quad) {
+    MBR_CHECK(quad.kind() == Surface::Kind::PlanarQuad);
+    const Vec3* c = quad.corners();
+    ShooterPlane sp;
+    sp.origin = 0.25 * (c[0] + c[1] + c[2] + c[3]);
+    // Newell's normal of the corners: the mean plane of a (slightly) non-planar quad. For four
+    // corners it is the cross product of the diagonals, which, unlike the sum of cross(c_i,
+    // c_{i+1}) over absolute positions (terms of order |c|^2 cancelling down to the area),
+    // keeps its digits for a quad far smaller than its distance from the origin (measured: a
+    // shooter of side 1e-8 at distance 1 got a normal off by radians).
+    sp.normal = normalize(cross(c[2] - c[0], c[3] - c[1]));
+    sp.e1 = normalize(c[1] - c[0] - dot(c[1] - c[0], sp.normal) * sp.normal);
+    sp.e2 = cross(sp.normal, sp.e1);
+    for (int i = 0; i < 4; ++i) sp.corner[i] = sp.to_plane(c[i]);
+    sp.outline.assign(sp.corner, sp.corner + 4);
+    // An exact parallelogram (the twist q0 - q1 + q2 - q3 vanishes to rounding): affine inverse.
+    const Vec2 e = sp.corner[1] - sp.corner[0], f = sp.corner[3] - sp.corner[0];
+    const Vec2 g = sp.corner[0] - sp.corner[1] + sp.corner[2] - sp.corner[3];
+    const double det = cross(e, f);
+    if (det != 0 && std::sqrt(dot(g, g)) <= 1e-14 * std::sqrt(std::fabs(det))) {
+        sp.parallelogram = true;
+        sp.inverse_row0 = Vec2{f.y, -f.x} * (1 / det);
+        sp.inverse_row1 = Vec2{-e.y, e.x} * (1 / det);
+    }
+    if (signed_area(sp.outline) < 0) std::reverse(sp.outline.begin(), sp.outline.end());
+    sp.size = std::sqrt(std::fabs(signed_area(sp.outline)));
+    return sp;
+}
+
+std::optional<Plane> surface_plane(const Surface& surface) {
+    if (surface.kind() == Surface::Kind::PlanarQuad) {
+        const Vec3* c = surface.corners();
+        // Newell's normal as the diagonals' cross product (see make_shooter_plane).
+        const Vec3 n = normalize(cross(c[2] - c[0], c[3] - c[1]));
+        const Vec3 o = 0.25 * (c[0] + c[1] + c[2] + c[3]);
+        // Only a quad planar to rounding: the scene format accepts corners 0.25 % off their
+        // mean plane, whose tangent planes then differ from it.
+        double size = 0, off = 0;
+        for (int i = 0; i < 4; ++i) {
+            size = std::max(size, length(c[i] - c[(i + 2) % 4]));
+            off = std::max(off, std::fabs(dot(n, c[i] - o)));
+        }
+        if (off > 1e-12 * size) return std::nullopt;
+        return Plane{n, dot(n, o)};
+    }
+    if (surface.kind() == Surface::Kind::Disk) {
+        const Vec3 n = surface.normal(0.5, 0.5);
+        return Plane{n, dot(n, surface.point(0.5, 0.5))};
+    }
+    return std::nullopt;
+}
+
+std::vector<int> occluders_toward(const OcclusionContext& context, const ShooterPlane& plane,
+                                  Vec3 p, size_t limit) {
+    // The pyramid: a plane through p and each edge of the shooter's outline, and the shooter's
+    // own plane (nothing beyond the shooter blocks a segment that ends on it).
+    struct Side {
+        Vec3 n;
+        double d;
+    };
+    std::vector<Side> sides;
+    const int nc = static_cast<int>(plane.outline.size());
+    double scale = length(p);
+    for (int i = 0; i < nc; ++i) {
+        const Vec3 a = plane.to_space(plane.outline[i]),
+                   b = plane.to_space(plane.outline[(i + 1) % nc]);
+        scale = std::max(scale, length(a));
+        Vec3 n = normalize(cross(b - a, p - a));
+        if (dot(n, plane.to_space(plane.outline[(i + 2) % nc]) - a) > 0) n = -1.0 * n;
+        sides.push_back({n, dot(n, a)});
+    }
+    sides.push_back({-1.0 * plane.normal, -dot(plane.normal, plane.origin)});
+    // DESIGN: a polygon or box within 1e-9 of the coordinates' size of the pyramid is kept.
+    const double tol = 1e-9 * scale;
+    auto outside_box = [&](const Box3& box) {
+        for (const Side& s : sides) {
+            const Vec3 inner{s.n.x > 0 ? box.lo.x : box.hi.x, s.n.y > 0 ? box.lo.y : box.hi.y,
+                             s.n.z > 0 ? box.lo.z : box.hi.z};
+            if (dot(s.n, inner) - s.d > tol) return true;
+        }
+        return false;
+    };
+    const std::vector<Polygon>& polys = context.octree->polygons();
+    auto outside_polygon = [&](int id) {
+        for (const Side& s : sides) {
+            bool all = true;
+            for (const Vec3& v : polys[id].vertices())
+                if (dot(s.n, v) - s.d <= tol) {
+                    all = false;
+                    break;
+                }
+            if (all) return true;
+        }
+        return false;
+    };
+    std::vector<int> out;
+    if (static_cast<int>(context.candidates.size()) <= context.exact_limit) {
+        for (int id : context.candidates)
+            if (!outside_polygon(id)) out.push_back(id);
+        return out;
+    }
+    // The octree's leaves one at a time (a polygon listed by several leaves comes several
+    // times): each listed candidate that meets the pyramid is kept, and the kept ones are made
+    // unique whenever they outgrow twice the limit; more than `limit` distinct ones stop the
+    // walk (the node test then refuses every further node).
+    bool enough = false;
+    auto compact = [&out] {
+        std::sort(out.begin(), out.end());
+        out.erase(std::unique(out.begin(), out.end()), out.end());
+    };
+    std::vector<int> listed;
+    auto keep_listed = [&] {  // the listed candidates that meet the pyramid
+        for (int id : listed)
+            if (std::binary_search(context.candidates.begin(), context.candidates.end(), id) &&
+                !outside_polygon(id))
+                out.push_back(id);
+        listed.clear();
+    };
+    context.octree->append_polygons_near(
+        [&](const Box3& b) {
+            if (enough) return false;
+            keep_listed();
+            if (limit != SIZE_MAX && out.size() > 2 * limit) {
+                compact();
+                enough = out.size() > limit;
+                if (enough) return false;
+            }
+            return !outside_box(b);
+        },
+        listed);
+    keep_listed();
+    compact();
+    return out;
+}
+
+namespace {
+
+/// How many of the points lie in front of the view's horizon line and how many behind it;
+/// points within BlockedView::front_tolerance of the line lie on it and count as neither.
+struct HorizonSides {
+    int front = 0, behind = 0;
+};
+HorizonSides horizon_sides(const BlockedView& view, const Vec2* points, size_t n) {
+    HorizonSides sides;
+    for (size_t i = 0; i < n; ++i) {
+        const double v = view.front.value(points[i]);
+        if (v > view.front_tolerance) ++sides.front;
+        if (v < -view.front_tolerance) ++sides.behind;
+    }
+    return sides;
+}
+
+}  // namespace
+
+BlockedView blocked_view(const ShooterPlane& plane, Vec3 p, Vec3 n_p,
+                         const OcclusionContext* context, const Plane* receiver_plane) {
+    BlockedView view;
+    // The horizon: the shooter's points x with n_p . (x - p) > 0 are in front of p (or, for a
+    // point of a planar receiver, in front of the receiver's plane: the same line each time).
+    if (receiver_plane)
+        view.front = HalfPlane{{dot(receiver_plane->normal, plane.e1), dot(receiver_plane->normal, plane.e2)},
+                               dot(receiver_plane->normal, plane.origin) - receiver_plane->offset};
+    else
+        view.front = HalfPlane{{dot(n_p, plane.e1), dot(n_p, plane.e2)}, dot(n_p, plane.origin - p)};
+    // DESIGN: a corner within rounding of the horizon line lies on it: within 1e-12 of the
+    // magnitudes its value is computed from (the shooter's size and the planes' distances from
+    // the origin), some 1e4 times their rounding. A shooter sharing an edge with the receiver
+    // (the walls of a box) has two corners on the line, and rounding put them in front or
+    // behind by turns: the horizon then cut the cells along that edge or not, and their rules
+    // (triangles or the tensor rule) differ by the quadrature's error, so that one scene in two
+    // units differed by it. (Not a fraction of the shooter's size alone: a shooter 1e9 times
+    // its distance from the receiver has its corners 1e-9 of its size in front.)
+    const double distances = receiver_plane
+                                 ? std::fabs(dot(receiver_plane->normal, plane.origin)) +
+                                       std::fabs(receiver_plane->offset)
+                                 : std::fabs(dot(n_p, plane.origin)) + std::fabs(dot(n_p, p));
+    const double magnitude = plane.size + distances;
+    view.front_tolerance = 1e-12 * magnitude;
+    const HorizonSides corners = horizon_sides(view, plane.corner, 4);
+    if (corners.front == 0) {
+        view.behind_all = true;
+        return view;
+    }
+    view.horizon_cuts = corners.behind > 0;
+
+    const double h_p = dot(plane.normal, p - plane.origin);  // height of p above the plane
+    if (!context || context->candidates.empty() || h_p <= 0) return view;
+    const std::vector<Polygon>& polys = context->octree->polygons();
+    // Many occluders for the pair (a big scene): only those that meet the pyramid from p to the
+    // shooter count for p, found with the octree; still too many: rays instead of projection.
+    std::vector<int> near_p;
+    const std::vector<int>* occluders = &context->candidates;
+    if (static_cast<int>(context->candidates.size()) > context->exact_limit) {
+        near_p = occluders_toward(*context, plane, p);
+        if (static_cast<int>(near_p.size()) > context->exact_limit) {
+            view.use_rays = true;
+            view.occluders = std::move(near_p);
+            return view;
+        }
+        occluders = &near_p;
+    }
+    for (int id : *occluders) {
+        // Keep the part of the occluder strictly between the plane and p (0 <= h < h_p), then
+        // project it from p: x -> p + h_p / (h_p - h(x)) (x - p).
+        const std::vector<Vec3>& vs = polys[id].vertices();
+        const int n = static_cast<int>(vs.size());
+        // DESIGN: occluder points within 1e-7 h_p of p's height are cut off: they could only
+        // block rays grazing the shooter's plane, and would project 1e7 times further out.
+        const double h_max = h_p * (1 - 1e-7);
+        std::vector<Vec3> slab;
+        slab.reserve(n + 4);
+        for (int i = 0; i < n; ++i) {
+            const Vec3 a = vs[i], b = vs[(i + 1) % n];
+            const double ha = dot(plane.normal, a - plane.origin);
+            const double hb = dot(plane.normal, b - plane.origin);
+            // Clip the edge to 0 <= h <= h_max (Sutherland-Hodgman against two planes at once:
+            // parameter range of the edge inside the slab).
+            auto inside = [&](double h) { return h >= 0 && h <= h_max; };
+            if (inside(ha)) slab.push_back(a);
+            double t0 = 0, t1 = 1;
+            const double dh = hb - ha;
+            if (dh != 0) {
+                double ta = (0 - ha) / dh, tb = (h_max - ha) / dh;
+                if (ta > tb) std::swap(ta, tb);
+                t0 = std::max(t0, ta);
+                t1 = std::min(t1, tb);
+            } else if (!inside(ha)) {
+                continue;
+            }
+            if (t0 > t1) continue;
+            // Entry and exit points strictly inside the edge.
+            if (t0 > 0 && t0 < 1) slab.push_back(a + t0 * (b - a));
+            if (t1 < 1 && t1 > t0 && t1 > 0) slab.push_back(a + t1 * (b - a));
+        }
+        if (slab.size() < 3) continue;
+        ConvexPolygon shadow;
+        shadow.reserve(slab.size());
+        for (const Vec3& x : slab) {
+            const double h = dot(plane.normal, x - plane.origin);
+            const Vec3 X = p + (h_p / (h_p - h)) * (x - p);
+            shadow.push_back(plane.to_plane(X));
+        }
+        const double area = signed_area(shadow);
+        if (area < 0) std::reverse(shadow.begin(), shadow.end());
+        if (std::fabs(area) <= 0) continue;  // an occluder seen edge-on hides nothing
+        shadow = intersect(shadow, plane.outline);
+        // DESIGN: a sliver at most 1e-10 of the shooter's size wide (or a speck 1e-7 of it
+        // across) is dropped (is_sliver): an occluder touching the shooter along its outline
+        // (a neighbouring face) leaves one of no area, whose nearly coincident vertices give
+        // edge lines pointing anywhere (see below). Its width, not its area against the
+        // shooter's: seen from a point close to a large shooter, a shadow small beside the
+        // shooter can hide most of what the point sees.
+        if (!is_sliver(shadow, 1e-10 * plane.size, 1e-7 * plane.size))
+            view.shadows.push_back(std::move(shadow));
+    }
+    merge_shadows(view.shadows);
+    // DESIGN: vertices within 1e-10 of the shooter's size of the line through their neighbours
+    // are removed (changing a shadow's area by about 1e-10 of the shooter's). Clipping and the
+    // hulls of merged faces leave such vertices where rounding decides, and an edge between
+    // two nearly equal vertices has a line pointing anywhere, along which the shadow stage
+    // would cut (subtract, classify).
+    for (ConvexPolygon& shadow : view.shadows) remove_flat_vertices(shadow, 1e-10 * plane.size);
+    return view;
+}
+
+void merge_shadows(std::vector<ConvexPolygon>& shadows) {
+    // The faces of one solid cast overlapping shadows (a box's top and sides); every cell a
+    // shadow edge cuts is integrated over convex pieces, and each overlapping shadow multiplies
+    // the pieces. Two shadows whose union is convex (one inside the other, or overlapping or
+    // touching so that no notch is left) become that
+    // union, until no pair merges (the faces of a convex solid usually end as one polygon,
+    // its silhouette's).
+    // DESIGN: the convexity test's tolerance, 1e-9 of the hull's area, only absorbs rounding.
+    std::vector<Rect> boxes;
+    for (const ConvexPolygon& s : shadows) boxes.push_back(bounding_rect(s));
+    for (bool merged = true; merged;) {
+        merged = false;
+        for (size_t i = 0; i < shadows.size(); ++i)
+            for (size_t j = i + 1; j < shadows.size(); ++j) {
+                // Shadows whose boxes do not even touch cannot have a convex union.
+                const Rect& a = boxes[i];
+                const Rect& b = boxes[j];
+                if (a.x1 < b.x0 || b.x1 < a.x0 || a.y1 < b.y0 || b.y1 < a.y0) continue;
+                // Overlapping, nested or only touching along an edge (two faces of one solid):
+                // the hull is the union exactly when the union is convex.
+                ConvexPolygon u = convex_union(shadows[i], shadows[j]);
+                if (u.empty()) continue;
+                shadows[i] = std::move(u);
+                boxes[i] = bounding_rect(shadows[i]);
+                shadows.erase(shadows.begin() + long(j));
+                boxes.erase(boxes.begin() + long(j));
+                merged = true;
+                j = i;  // shadow i grew: check it against the others again
+            }
+    }
+}
+
+CellVisibility classify_cell(const ConvexPolygon& cell, const BlockedView& view, bool* shadowed) {
+    if (shadowed) *shadowed = false;
+    if (view.behind_all) return CellVisibility::hidden;
+    bool cut = false;
+    if (view.horizon_cuts) {
+        const HorizonSides sides = horizon_sides(view, cell.data(), cell.size());
+        if (sides.front == 0) return CellVisibility::hidden;
+        cut = sides.behind > 0;
+    }
+    for (const ConvexPolygon& s : view.shadows) {
+        const Overlap o = classify(cell, s);
+        if (o == Overlap::inside) return CellVisibility::hidden;
+        if (o == Overlap::partial) {
+            cut = true;
+            if (shadowed) *shadowed = true;
+        }
+    }
+    return cut ? CellVisibility::cut : CellVisibility::clear;
+}
+
+std::vector<ConvexPolygon> visible_pieces(const ConvexPolygon& cell, const BlockedView& view) {
+    std::vector<ConvexPolygon> pieces;
+    ConvexPolygon first = view.horizon_cuts ? clip(cell, view.front) : cell;
+    if (first.empty()) return pieces;
+    pieces.push_back(std::move(first));
+    // DESIGN: slivers below 1e-14 of the cell's area are dropped (they hold no measurable
+    // energy and only cost quadrature points).
+    const double min_area = 1e-14 * std::fabs(signed_area(cell));
+    for (const ConvexPolygon& s : view.shadows) {
+        if (classify(cell, s) == Overlap::disjoint) continue;
+        std::vector<ConvexPolygon> next;
+        for (const ConvexPolygon& piece : pieces) {
+            std::vector<ConvexPolygon> rest = subtract(piece, s, min_area);
+            for (ConvexPolygon& r : rest) next.push_back(std::move(r));
+        }
+        pieces = std::move(next);
+        if (pieces.empty()) break;
+    }
+    // The pieces' fans (pieces_value) follow the geometry, not where clipping began nor which
+    // near-repeated vertices rounding left (each would add a fan triangle of no area).
+    for (ConvexPolygon& piece : pieces) {
+        remove_flat_vertices(piece, 1e-9 * std::sqrt(std::fabs(signed_area(cell))));
+        start_at_canonical_vertex(piece);
+    }
+    return pieces;
+}
+
+}  // namespace mbr

@@ -1,0 +1,175 @@
+// radiosity/visibility/visible_parts.h - visibility in one energy transfer (paper section 5, "Adaptive Subdivision
+// in Shadow Computation"; section 6, "Shadow" and "Octree"; eq. (28); DESIGN.md section 3,
+// stage 7).
+//
+// Two methods, chosen by ShadowOptions::method:
+//   Fractions (the paper's, the default): the transfer is computed without shadows; then, for
+//     each selected fulcrum, rays are cast to every patch of the shooter partition that the
+//     adaptive quadrature of (21) formed for that point, the visible fraction is (28), leaves
+//     between fulcrums whose fractions differ are split (shadow subdivision), and every
+//     coefficient is multiplied by its fulcrum's fraction.
+//   Exact (beyond the paper): VIS enters (21) itself. For a planar shooter the occluders are
+//     projected from the receiving point onto the shooter's plane, and the quadrature integrates
+//     over exactly the visible part of each shooter cell (cells the projections cut are split
+//     into convex pieces); the shadowed samples are then projected like any others, so the
+//     oracle refines the receiver where the shadow needs it. Other shooters fall back to one
+//     ray per quadrature node, splitting the shooter cells whose nodes disagree.
+// Both use the paper's octree: a pair of surfaces that no polygon can come between (none meets
+// the convex hull of the two) casts no rays and projects nothing.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include "math/convex2d.h"
+#include "octree/octree.h"
+#include "radiosity/geometry/surface.h"
+
+namespace mbr {
+
+/// How visibility enters a transfer.
+enum class ShadowMethod {
+    None,       // VIS = 1
+    Fractions,  // the paper's: fractions (28) at fulcrums, shadow subdivision, masking
+    Exact       // VIS inside (21): the visible part of the shooter, projected like any samples
+};
+
+/// Options of the shadow stage.
+struct ShadowOptions {
+    ShadowMethod method = ShadowMethod::Fractions;
+    int rays_per_patch = 4;   // rays from a fulcrum to each patch of its shooter partition (28)
+    int min_patch_depth = 3;  // the partition of a fraction is at least this deep (the adaptive
+                              //   quadrature of (21) run with this minimum depth)
+    double threshold = 0.05;  // fractions of neighbouring fulcrums differing by more split the
+                              //   leaves between them (largest channel)
+    int max_depth = 6;        // shadow subdivision stops at leaves of this level
+    int max_node_depth = 10;  // Exact on a curved shooter: depth to which shooter cells whose
+                              //   quadrature nodes disagree on visibility are split
+};
+
+/// The occluders of one shooter -> receiver pair: the polygons (of an octree over the scene)
+/// that meet the convex hull of the two surfaces, other than the two surfaces' own.
+struct OcclusionContext {
+    const Octree* octree = nullptr;
+    int shooter_surface = -1;  // surface ids as the octree's polygons carry them
+    int receiver_surface = -1;
+    std::vector<int> candidates;  // polygon indices, increasing
+    std::uint64_t seed = 0;       // of every ray of the transfer: the pair and the shot number
+    int exact_limit = 24;         // exact visibility projects at most this many occluders for
+                                  //   one receiving point; beyond, one ray per quadrature node
+    /// True when nothing can come between the two surfaces.
+    bool clear() const { return candidates.empty(); }
+};
+
+/// The points whose convex hull holds a surface: the corners of a planar quad, else the eight
+/// corners of its bounding box.
+std::vector<Vec3> hull_points(const Surface& surface);
+
+/// The occluders between two surfaces, found with the octree (nodes and polygons outside the
+/// convex hull of both surfaces' hull_points are skipped). `shot` enters the seed.
+OcclusionContext make_occlusion_context(const Octree& octree, const Surface& shooter,
+                                        int shooter_surface, const Surface& receiver,
+                                        int receiver_surface, std::uint64_t shot);
+
+/// Up to this many occluders a segment is tested against the list one by one; beyond, the
+/// octree is faster (segment_blocked with a list, occluders_toward's limit).
+constexpr size_t max_listed_occluders = 32;
+
+/// True when an occluder of the context blocks the open segment a -> b (any-hit: a loop over
+/// the candidates when they are few, else the octree with the pair's own surfaces skipped; the
+/// answer is the same). Counts the ray in *n_rays.
+bool segment_blocked(const OcclusionContext& context, Vec3 a, Vec3 b, long* n_rays);
+/// The same against a subset of the candidates known to hold every polygon that can meet the
+/// segment (occluders_toward); an empty subset casts no ray.
+bool segment_blocked(const OcclusionContext& context, const std::vector<int>& occluders, Vec3 a,
+                     Vec3 b, long* n_rays);
+
+/// A planar quad shooter in a 2D frame of its plane: what exact visibility clips.
+struct ShooterPlane {
+    Vec3 origin, e1, e2, normal;  // orthonormal frame; normal is the shooter's front
+    Vec2 corner[4];               // corners at (u,v) = (0,0), (1,0), (1,1), (0,1)
+    ConvexPolygon outline;        // the same, counter-clockwise
+    double size = 0;              // the square root of its area: the scale of its tolerances
+    Vec2 to_plane(Vec3 x) const { return {dot(x - origin, e1), dot(x - origin, e2)}; }
+    Vec3 to_space(Vec2 q) const { return origin + q.x * e1 + q.y * e2; }
+    /// The point of the bilinear map at (u, v), in the frame.
+    Vec2 at(double u, double v) const;
+    bool parallelogram = false;       // the map is affine: parameters() by a 2 x 2 inverse
+    Vec2 inverse_row0, inverse_row1;  // that inverse (when parallelogram)
+    /// (u, v) of a point of the plane (inverse bilinear map).
+    Vec2 parameters(Vec2 q) const {
+        if (parallelogram) {
+            const Vec2 d = q - corner[0];
+            return {dot(inverse_row0, d), dot(inverse_row1, d)};
+        }
+        return inverse_bilinear(corner[0], corner[1], corner[2], corner[3], q);
+    }
+    /// (u, v) of q from a nearby guess: one Newton step on the bilinear map (exact for a
+    /// parallelogram; from a guess off by d, off by about |twist| d^2 after it).
+    Vec2 refine_parameters(Vec2 q, Vec2 guess) const {
+        if (parallelogram) return parameters(q);
+        const Vec2 e = corner[1] - corner[0], f = corner[3] - corner[0];
+        const Vec2 g = corner[0] - corner[1] + corner[2] - corner[3];
+        const double u = guess.x, v = guess.y;
+        const Vec2 r = corner[0] + u * e + v * f + (u * v) * g - q;
+        const Vec2 pu = e + v * g, pv = f + u * g;
+        const double det = cross(pu, pv);
+        if (det == 0) return guess;
+        return {u - cross(r, pv) / det, v - cross(pu, r) / det};
+    }
+};
+/// The frame of a planar quad (its corners projected onto their mean plane).
+ShooterPlane make_shooter_plane(const Surface& planar_quad);
+
+/// What a receiving point cannot see of a planar shooter: the part behind its tangent plane
+/// (the horizon, where the clamped cosine of (3) has a kink) and, with exact visibility, the
+/// central projections of the occluders onto the shooter's plane, clipped to the shooter.
+struct BlockedView {
+    bool behind_all = false;             // the whole shooter is behind the horizon
+    bool horizon_cuts = false;           // the horizon line crosses the shooter
+    HalfPlane front;                     // the visible side of the horizon line
+    double front_tolerance = 0;          // points within it of the line lie on it
+    std::vector<ConvexPolygon> shadows;  // projected occluders (counter-clockwise)
+    bool use_rays = false;               // too many occluders for projection (exact_limit):
+                                         //   visibility by one ray per quadrature node
+    std::vector<int> occluders;          // then: the occluders that meet p's pyramid
+    bool trivial() const { return !behind_all && !horizon_cuts && shadows.empty() && !use_rays; }
+};
+/// The context's candidates that meet the pyramid from p to a planar shooter (the convex hull
+/// of p and the shooter's outline), increasing: the only polygons that can block a segment
+/// from p to a point of the shooter. The octree finds them when the candidates are many.
+/// With a `limit`, the search stops as soon as more than `limit` distinct occluders are found
+/// and returns those (more than `limit`, not all): enough for a caller that tests rays against
+/// the list when it is short and against the octree otherwise.
+std::vector<int> occluders_toward(const OcclusionContext& context, const ShooterPlane& plane,
+                                  Vec3 p, size_t limit = SIZE_MAX);
+
+/// The view from point p (normal n_p). `context` may be null (horizon only). When p lies on a
+/// planar receiver, `receiver_plane` (may be null) gives its plane: the horizon is then the
+/// same line for every point of the receiver, to the last bit.
+BlockedView blocked_view(const ShooterPlane& plane, Vec3 p, Vec3 n_p,
+                         const OcclusionContext* context, const Plane* receiver_plane = nullptr);
+
+/// The plane of a planar quad (Newell's normal through the corners' mean; only when its corners
+/// lie on it to rounding) or a disk, oriented by its front; nothing for other surfaces.
+std::optional<Plane> surface_plane(const Surface& surface);
+
+/// Drops shadows inside another and merges pairs whose union is convex, until none merges.
+void merge_shadows(std::vector<ConvexPolygon>& shadows);
+
+/// How a shooter cell (its image, a convex quad of the plane) lies in a view.
+enum class CellVisibility { clear, hidden, cut };
+/// The same, also saying whether a shadow takes part in the cut (*shadowed; false when only
+/// the horizon cuts the cell).
+CellVisibility classify_cell(const ConvexPolygon& cell, const BlockedView& view,
+                             bool* shadowed = nullptr);
+/// The visible part of a cut cell as disjoint convex pieces.
+std::vector<ConvexPolygon> visible_pieces(const ConvexPolygon& cell, const BlockedView& view);
+
+/// A reproducible 64-bit hash of a few integers (splitmix64 steps), for seeding rays.
+std::uint64_t hash_seed(std::uint64_t a, std::uint64_t b, std::uint64_t c = 0, std::uint64_t d = 0);
+/// A uniform double in [0, 1) from a counter (the hash of `key` and `index`).
+double uniform01(std::uint64_t key, std::uint64_t index);
+
+}  // namespace mbr
