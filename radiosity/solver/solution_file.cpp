@@ -1,5 +1,7 @@
 // radiosity/solver/solution_file.cpp - saving and loading solved fields (docs/solution-format.md), so
 // that rendering can be separate from solving.
+#include "radiosity/solver/solution_file.h"
+
 #include <cinttypes>
 #include <cstdio>
 #include <cstring>

@@ -161,15 +161,8 @@ Solution solve(const Scene& scene, const Octree& octree, const SolverOptions& op
 /// then the Gram solve of math/wavelet.h's kind).
 SplineField project_emission(const Texture& emission, int m, int level);
 
-/// Solution files (docs/solution-format.md): a versioned text format holding each surface's
-/// name and both fields, with a fingerprint of the scene's surfaces. save_solution writes through
-/// `out`; load_solution refuses a damaged, truncated, foreign or mismatched file with an
-/// InputError naming `name` (the file) and the line.
-void save_solution(std::ostream& out, const Scene& scene, const Solution& solution);
-Solution load_solution(std::istream& in, const std::string& name, const Scene& scene);
-
-/// A fingerprint of the scene's surfaces and materials (names, kinds, corners, reflectance and
-/// emission means), for matching solution files to scenes.
-std::uint64_t scene_fingerprint(const Scene& scene);
-
 }  // namespace mbr
+
+// Saving and loading solutions: solution_file.h, included here so that includers of solver.h
+// keep compiling.
+#include "radiosity/solver/solution_file.h"
