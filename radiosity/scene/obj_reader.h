@@ -1,0 +1,51 @@
+// radiosity/scene/obj_reader.h - Wavefront OBJ + MTL import (docs/scene-format.md, "OBJ import"):
+// vertices and faces to the planar quads of paper section 2, Kd and Ke to the reflectance rho
+// and emission E of eq. (1). Every bad input becomes one InputError naming the file and line.
+#pragma once
+
+#include <iosfwd>
+#include <string>
+#include <unordered_map>
+
+#include "radiosity/scene/line_reader.h"
+#include "radiosity/scene/scene.h"
+
+namespace mbr {
+
+/// Imports a Wavefront OBJ file and the MTL libraries it names (docs/scene-format.md, "OBJ
+/// import"): Kd -> reflectance, Ke (emitted radiance) -> emission E = pi Ke, every face ->
+/// one or more planar quads. The scene has no camera and default settings. Throws InputError.
+Scene load_obj(const std::string& path);
+
+/// Parses OBJ text from a stream; `name` is used in messages and to resolve `mtllib` paths.
+Scene parse_obj(std::istream& in, const std::string& name);
+
+namespace detail {
+
+/// The material of OBJ faces before any `usemtl`; a scene that imports several OBJ files
+/// shares one.
+constexpr const char* obj_default_material = "obj_default";
+
+/// What the readers of one top-level load share: the count of files opened, which bounds
+/// exponential include trees, and the texture images decoded so far.
+class LoadState {
+public:
+    /// Counts one more file read on behalf of `line` (at most 1000 per load).
+    void charge(const Line& line);
+
+    /// The image file at `path` (resolved), unscaled. Each file is read and decoded once per
+    /// load, however many materials name it (a big image costs its memory once, not once per
+    /// material); later requests share its texels and are not charged as files read.
+    Texture image(const Line& line, const std::string& path);
+
+private:
+    int n_files_ = 0;
+    std::unordered_map<std::string, Texture> textures_;  // canonical path -> decoded image
+};
+
+/// Reads OBJ text named `name` as part of the load `state` (parse_obj with a shared state).
+Scene read_obj(std::istream& in, const std::string& name, LoadState& state);
+
+}  // namespace detail
+
+}  // namespace mbr
