@@ -16,6 +16,7 @@
 #include <sstream>
 
 #include "math/check.h"
+#include "radiosity/scene/line_reader.h"
 
 namespace mbr {
 
@@ -23,40 +24,21 @@ namespace {
 
 // ---- CSV reading ---------------------------------------------------------------------------
 
-std::string trim(const std::string& s) {
-    size_t b = 0, e = s.size();
-    while (b < e && (s[b] == ' ' || s[b] == '\t')) ++b;
-    while (e > b && (s[e - 1] == ' ' || s[e - 1] == '\t')) --e;
-    return s.substr(b, e - b);
-}
-
 std::string lower(std::string s) {
     for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
     return s;
 }
 
-std::vector<std::string> split_fields(const std::string& line) {
-    std::vector<std::string> fields;
-    size_t start = 0;
-    for (;;) {
-        size_t comma = line.find(',', start);
-        fields.push_back(trim(line.substr(start, comma - start)));
-        if (comma == std::string::npos) return fields;
-        start = comma + 1;
-    }
-}
-
-bool is_blank(const std::string& line) {
-    return std::all_of(line.begin(), line.end(), [](char c) { return c == ' ' || c == '\t'; });
-}
-
-// The next line without its '\r' (and, on line 1, without a UTF-8 byte order mark).
-bool next_line(std::istream& in, std::string& line, int& line_no) {
-    if (!std::getline(in, line)) return false;
-    ++line_no;
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    if (line_no == 1 && line.compare(0, 3, "\xEF\xBB\xBF") == 0) line.erase(0, 3);
-    return true;
+// The CSV's lines (radiosity/scene/line_reader.h): fields split at commas and trimmed of spaces
+// and tabs, one trailing '\r' dropped, a UTF-8 byte order mark on line 1 dropped, lines of blanks
+// skipped; no comments, no line-length limit, any bytes inside a field.
+LineFormat csv_format() {
+    LineFormat f;
+    f.max_length = 0;
+    f.comments = false;
+    f.control_bytes = true;
+    f.separator = ',';
+    return f;
 }
 
 double parse_field(const std::string& field, const std::string& column, const std::string& file,
@@ -263,19 +245,13 @@ std::map<int, std::vector<int>> start_polygons(const Scene& scene,
 // ---- CSV reading ---------------------------------------------------------------------------
 
 std::vector<ProbePoint> parse_probe_points(std::istream& in, const std::string& name) {
-    std::string line;
-    int line_no = 0;
-    bool have_header = false;
-    while (next_line(in, line, line_no))
-        if (!is_blank(line)) {
-            have_header = true;
-            break;
-        }
-    if (!have_header) throw InputError(name, 0, "the file is empty: expected a header row");
-    const int header_line = line_no;
+    LineReader reader(in, name, csv_format());
+    Line line;
+    if (!reader.next(line)) throw InputError(name, 0, "the file is empty: expected a header row");
+    const int header_line = line.number;
 
     // Column indices of the known names.
-    const std::vector<std::string> header = split_fields(line);
+    const std::vector<std::string> header = line.tokens;
     std::map<std::string, int> column;
     for (int i = 0; i < static_cast<int>(header.size()); ++i) {
         const std::string key = lower(header[i]);
@@ -298,9 +274,9 @@ std::vector<ProbePoint> parse_probe_points(std::istream& in, const std::string& 
 
     std::vector<ProbePoint> points;
     std::map<std::string, int> first_line;
-    while (next_line(in, line, line_no)) {
-        if (is_blank(line)) continue;
-        const std::vector<std::string> fields = split_fields(line);
+    while (reader.next(line)) {
+        const int line_no = line.number;
+        const std::vector<std::string>& fields = line.tokens;
         if (fields.size() != header.size())
             throw InputError(name, line_no,
                              "expected " + std::to_string(header.size()) +

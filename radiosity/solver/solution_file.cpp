@@ -1,16 +1,19 @@
-// radiosity/solver/solution_file.cpp - saving and loading solved fields (docs/solution-format.md), so
-// that rendering can be separate from solving.
+// radiosity/solver/solution_file.cpp - saving and loading solved fields (docs/solution-format.md),
+// so that rendering can be separate from solving.
 #include "radiosity/solver/solution_file.h"
 
+#include <cerrno>
 #include <cinttypes>
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <istream>
 #include <ostream>
-#include <sstream>
 
 #include "math/bspline.h"
 #include "math/check.h"
+#include "radiosity/scene/line_reader.h"
 #include "radiosity/solver/solver.h"
 
 namespace mbr {
@@ -47,23 +50,21 @@ void write_field(std::ostream& out, const char* what, const SplineField& f) {
     }
 }
 
-/// Reads the file line by line and reports problems with the file name and line.
+/// Reads the file line by line and reports problems with the file name and line. The lines are
+/// read by the scene's line reader (radiosity/scene/line_reader.h) with the solution format's
+/// differences: no comments, no byte order mark, no blank lines skipped, any bytes but blanks
+/// inside a word, lines of up to 64 MiB.
 class Reader {
 public:
-    Reader(std::istream& in, const std::string& name) : in_(in), name_(name) {}
+    Reader(std::istream& in, const std::string& name) : name_(name), lines_(in, name, format()) {}
     std::vector<std::string> words(const char* expecting) {
-        std::string line;
-        if (!std::getline(in_, line))
+        Line line;
+        if (!lines_.next(line))
             fail("the file ends early (expected " + std::string(expecting) + "): truncated?");
-        ++line_;
-        if (line.size() > (size_t(1) << 26)) fail("line is too long");
-        std::istringstream is(line);
-        std::vector<std::string> out;
-        for (std::string w; is >> w;) out.push_back(w);
-        return out;
+        return std::move(line.tokens);
     }
     [[noreturn]] void fail(const std::string& message) const {
-        throw InputError(name_, line_, message);
+        throw InputError(name_, lines_.number(), message);
     }
     long integer(const std::string& w, long lo, long hi, const char* what) const {
         char* end = nullptr;
@@ -87,9 +88,19 @@ public:
     }
 
 private:
-    std::istream& in_;
+    static LineFormat format() {
+        LineFormat f;
+        f.max_length = size_t(1) << 26;
+        f.too_long = "line is too long";
+        f.comments = false;
+        f.byte_order_mark = false;
+        f.control_bytes = true;
+        f.skip_blank = false;
+        return f;
+    }
+
     std::string name_;
-    int line_ = 0;
+    LineReader lines_;
 };
 
 SplineField read_field(Reader& r, const char* what, int m) {
