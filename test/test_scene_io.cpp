@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "math/check.h"
+#include "radiosity/scene/line_reader.h"
 #include "radiosity/scene/scene_io.h"
 #include "radiosity/solver/solver.h"
 
@@ -974,4 +975,67 @@ TEST_CASE("texture: scaled copies share the texels and scale every statistic",
     CHECK(c.value(0.1, 0.1).r == 0.5);
     CHECK(c.value(0.6, 0.1).r == 0.25);
     CHECK(!c.shares_texels(c));  // procedural: no texels
+}
+
+TEST_CASE("line_reader: the formats of scenes, solution files and probe CSVs",
+          "[scene_io][line_reader]") {
+    // Scenes (the defaults): blank-separated tokens, '#' comments, blank lines skipped.
+    {
+        std::istringstream in(std::string("\xEF\xBB\xBF") + "a b\t# note\n\n  \r\nc\n");
+        LineReader reader(in, "s");
+        Line line;
+        REQUIRE(reader.next(line));
+        CHECK(line.number == 1);
+        CHECK(line.tokens == std::vector<std::string>{"a", "b"});
+        REQUIRE(reader.next(line));
+        CHECK(line.number == 4);
+        CHECK(line.tokens == std::vector<std::string>{"c"});
+        CHECK(!reader.next(line));
+        CHECK(reader.number() == 4);  // the end leaves the last line's number
+    }
+    // Solution files: every line returned, '#' and control bytes are part of words, a limit with
+    // its own message.
+    {
+        LineFormat f;
+        f.max_length = 4;
+        f.too_long = "line is too long";
+        f.comments = false;
+        f.control_bytes = true;
+        f.skip_blank = false;
+        std::istringstream in("a#b\n\n\x01\nabcde\n");
+        LineReader reader(in, "f", f);
+        Line line;
+        REQUIRE(reader.next(line));
+        CHECK(line.tokens == std::vector<std::string>{"a#b"});
+        REQUIRE(reader.next(line));
+        CHECK(line.number == 2);
+        CHECK(line.tokens.empty());
+        REQUIRE(reader.next(line));
+        CHECK(line.tokens == std::vector<std::string>{"\x01"});
+        try {
+            reader.next(line);
+            FAIL("no InputError for a line beyond the limit");
+        } catch (const InputError& e) {
+            CHECK(e.line() == 4);
+            CHECK(e.message() == "line is too long");
+        }
+    }
+    // Probe CSVs: fields at commas, trimmed of spaces and tabs (not of other bytes), empty
+    // fields kept, one trailing '\r' dropped, lines of blanks skipped.
+    {
+        LineFormat f;
+        f.max_length = 0;
+        f.comments = false;
+        f.control_bytes = true;
+        f.separator = ',';
+        std::istringstream in(" a ,,\tb#\r\n \t\r\n\v\n");
+        LineReader reader(in, "p", f);
+        Line line;
+        REQUIRE(reader.next(line));
+        CHECK(line.tokens == std::vector<std::string>{"a", "", "b#"});
+        REQUIRE(reader.next(line));
+        CHECK(line.number == 3);
+        CHECK(line.tokens == std::vector<std::string>{"\v"});
+        CHECK(!reader.next(line));
+    }
 }
