@@ -20,7 +20,7 @@
 #include "examples/common/transfer_cli.h"
 #include "radiosity/visibility/hidden_regions.h"
 #include "radiosity/transfer/sample_values.h"
-#include "radiosity/transfer/receiver.h"
+#include "radiosity/transfer/transfer.h"
 #include "radiosity/scene/scene_io.h"
 #include "radiosity/scene/scene_octree.h"
 #include "radiosity/visibility/visible_parts.h"

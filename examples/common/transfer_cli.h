@@ -5,7 +5,7 @@
 #include <string>
 
 #include "examples/common/cli.h"
-#include "radiosity/transfer/receiver.h"
+#include "radiosity/transfer/transfer.h"
 #include "radiosity/reference/configurations.h"
 
 namespace mbr {

@@ -17,7 +17,7 @@
 #include <iostream>
 
 #include "examples/common/cli.h"
-#include "radiosity/transfer/receiver.h"
+#include "radiosity/transfer/transfer.h"
 #include "radiosity/reference/configurations.h"
 
 namespace {

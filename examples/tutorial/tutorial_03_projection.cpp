@@ -23,7 +23,7 @@
 #include "examples/common/plot.h"
 #include "math/dual_basis.h"
 #include "math/parallel.h"
-#include "radiosity/transfer/receiver.h"
+#include "radiosity/transfer/transfer.h"
 
 namespace mbr {
 namespace {
@@ -55,14 +55,14 @@ std::vector<TestFunction> test_functions() {
 }
 
 // Eq. (19) for every basis function of level j that touches [0,1]^2, by the library's stage 6
-// (radiosity/transfer/receiver.h: project). In a transfer, project() integrates the samples of (21) over
+// (radiosity/transfer/projection.h: project). In a transfer, project() integrates the samples of (21) over
 // the leaves of an adaptive quadtree; here the tree is uniform at level j, wide enough for every
 // rhombus, and its samples are f at the m x m Gauss-Legendre nodes of each leaf.
 SplineField project_function(const std::function<double(double, double)>& f, int m, int j,
                              double radius, const DualTable& dn) {
-    ReceiverState state;
-    state.options.m = m;
-    state.rhombus_radius = radius;  // in cells of the basis scale 2^-j
+    ReceiverOptions options;
+    options.m = m;
+    ReceiverState state(options, radius);  // rhombus radius in cells of the basis scale 2^-j
     const int K = static_cast<int>(std::ceil((radius + m) * std::ldexp(1.0, -j)));
     state.forest = Forest(K);  // unit roots (I, J), |I|, |J| <= K; (0,0) is [0,1]^2
     for (int level = 0; level < j; ++level)

@@ -6,7 +6,7 @@
 // (22) along the four edges, the expanded domain (eight patches around [0,1]^2, Figure 5) is
 // subdivided and sampled by extrapolation, linear (23)-(25) or higher order (26)-(27). This
 // program, on the Table 1 configuration at a uniform depth,
-//   1. runs stages 1-3 (radiosity/transfer/receiver.h) and checks the edgefill profile of the bottom edge
+//   1. runs stages 1-3 (radiosity/transfer/transfer.h) and checks the edgefill profile of the bottom edge
 //      against the analytic form factor and its derivative;
 //   2. builds the expanded domain (expand_domain) and counts its leaves per patch and level;
 //   3. finishes the transfer with each continuation: none (zero outside), linear, quadratic (26),
@@ -21,7 +21,7 @@
 
 #include "examples/common/cli.h"
 #include "examples/common/plot.h"
-#include "radiosity/transfer/receiver.h"
+#include "radiosity/transfer/transfer.h"
 #include "radiosity/reference/configurations.h"
 
 namespace mbr {
@@ -150,9 +150,7 @@ int run(Args& args) {
               << ", uniform depth " << d << ", m = " << m << "\n\n";
 
     // Stages 1-3: the tree (uniform here), its samples (21), and edgefill along the four edges.
-    ReceiverState base;
-    base.options = options;
-    base.rhombus_radius = rhombus_radius_cells(options, dn);
+    ReceiverState base(options, rhombus_radius_cells(options, dn));
     subdivide_by_oracle(base, sampler);
     adjust_neighbour_scales(base.forest, Forest::Region::Domain);
     sample_leaves(base, sampler);

@@ -4,7 +4,7 @@
 // (Figure 2), each coefficient is the projection (19) onto a dual basis function truncated to a
 // rhombus (Figure 3), and coefficients of different scales are unified to the finest by (17).
 // On parallel squares at h = 0.1 with an adaptive tree (leaves of two sizes), this program
-//   1. selects the fulcrums (select_fulcrums, radiosity/transfer/receiver.h) and counts them per level;
+//   1. selects the fulcrums (select_fulcrums, radiosity/transfer/projection.h) and counts them per level;
 //   2. gives the rhombus radius for a ladder of truncations (DualTable::rhombus_radius) and
 //      projects one coefficient with each (project), against the widest;
 //   3. projects all selected coefficients (project_in_rhombi), unifies the scales
@@ -126,9 +126,7 @@ int run(Args& args) {
     // Stages 1-4 as in chapters 4 and 5, then stage 5: the fulcrums (Figure 2). For even m the
     // corners of every domain leaf at the leaf's scale, so a corner shared by leaves of two
     // sizes carries two fulcrums; and the fulcrums of ring leaves whose B-spline reaches inside.
-    ReceiverState state;
-    state.options = options;
-    state.rhombus_radius = rhombus_radius_cells(options, dn);
+    ReceiverState state(options, rhombus_radius_cells(options, dn));
     subdivide_by_oracle(state, sampler);
     adjust_neighbour_scales(state.forest, Forest::Region::Domain);
     sample_leaves(state, sampler);
@@ -205,7 +203,7 @@ int run(Args& args) {
               << " %\n  rea with unification by projection: " << cell(100 * projection_rule.rea, 4)
               << " %\n\n";
 
-    // The whole transfer (radiosity/transfer/receiver.h, transfer) for each truncation.
+    // The whole transfer (radiosity/transfer/transfer.h, transfer) for each truncation.
     std::cout << "4. The whole transfer against the truncation\n";
     Plot plot;
     plot.title = "rea against the rhombus radius, h = " + cell_g(h, 3);

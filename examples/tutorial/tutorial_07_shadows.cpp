@@ -6,7 +6,7 @@
 // opaque square hangs between a shooter and a receiver, and we follow the paper's answer:
 //   1. an octree over the three polygons finds what can block the pair (octree/octree.h);
 //   2. at every fulcrum, rays to the patches of the shooter's quadrature partition give the
-//      visible fraction (28), sum r_i e_i / sum e_i (fraction_at, radiosity/transfer/receiver.h);
+//      visible fraction (28), sum r_i e_i / sum e_i (fraction_at, radiosity/transfer/shadows.h);
 //   3. leaves between fulcrums whose fractions differ are split ("shadow subdivision"), down
 //      to a maximum shadow depth, and every coefficient is multiplied by its fraction
 //      (apply_shadows, radiosity/transfer/shadows.cpp).
@@ -28,7 +28,7 @@
 #include "octree/octree.h"
 #include "radiosity/output/image.h"
 #include "radiosity/transfer/sample_values.h"
-#include "radiosity/transfer/receiver.h"
+#include "radiosity/transfer/transfer.h"
 #include "radiosity/reference/configurations.h"
 #include "radiosity/visibility/visible_parts.h"
 

@@ -90,7 +90,7 @@ int run(Args& args) {
 
     // The while loop of the algorithm box. shoot() picks the surface with the largest unshot
     // power, makes one transfer to every surface that can receive from it
-    // (radiosity/transfer/receiver.h), adds the increments and zeroes the shooter's unshot field.
+    // (radiosity/transfer/transfer.h), adds the increments and zeroes the shooter's unshot field.
     Table table({"shot", "shooter", "shot_%", "unshot_before_%", "unshot_after_%", "incident_%",
                  "reflected_%", "receivers", "kernel_evals", "rays"});
     double sum_shot = 0, sum_incident = 0, sum_reflected = 0, worst_balance = 0;

@@ -1,4 +1,5 @@
-// radiosity/transfer/sample_values.cpp - the analytic reference form factor and the adaptive quadrature of (21).
+// radiosity/transfer/sample_values.cpp - the adaptive quadrature of (21) over the shooter (paper
+// section 6, "Adaptive Quadrature"), with exact visibility when asked.
 #include "radiosity/transfer/sample_values.h"
 
 #include <algorithm>
@@ -7,53 +8,6 @@
 #include "math/check.h"
 
 namespace mbr {
-
-double point_polygon_form_factor(Vec3 p, Vec3 n_p, const std::vector<Vec3>& polygon) {
-    if (polygon.size() < 3) return 0;
-    // One-sided: the polygon's front (Newell normal of its counter-clockwise order) must face p.
-    // The normal is summed from vectors relative to the first vertex: from absolute positions
-    // each cross(a, b) is of order |a| |b| and they cancel down to twice the area, which loses
-    // every digit for a polygon far smaller than its distance from the origin.
-    Vec3 normal{};
-    for (size_t i = 1; i + 1 < polygon.size(); ++i)
-        normal += cross(polygon[i] - polygon[0], polygon[i + 1] - polygon[0]);
-    Vec3 centroid{};
-    for (const Vec3& v : polygon) centroid += v - polygon[0];
-    centroid = polygon[0] + centroid / double(polygon.size());
-    if (dot(p - centroid, normal) <= 0) return 0;
-
-    // Clip against p's tangent plane: keep the part with (v - p) . n_p >= 0.
-    std::vector<Vec3> clipped;
-    clipped.reserve(polygon.size() + 2);
-    for (size_t i = 0; i < polygon.size(); ++i) {
-        const Vec3& a = polygon[i];
-        const Vec3& b = polygon[(i + 1) % polygon.size()];
-        const double da = dot(a - p, n_p), db = dot(b - p, n_p);
-        if (da >= 0) clipped.push_back(a);
-        if ((da >= 0) != (db >= 0)) clipped.push_back(a + (da / (da - db)) * (b - a));
-    }
-    if (clipped.size() < 3) return 0;
-
-    // Lambert: F = (1 / 2 pi) sum_i gamma_i n_p . (R_i x R_{i+1}) / |R_i x R_{i+1}|.
-    // R_i x R_{i+1} is taken as R_i x E_i with the edge E_i = v_{i+1} - v_i from the vertices
-    // themselves: for a polygon of size s at distance r, R_i and R_{i+1} are nearly parallel,
-    // and their cross product (of size s r) carries an absolute rounding error of order
-    // eps r^2, so its direction is off by eps r / s; the terms (of order s / r) cancel down to
-    // F (of order s^2 / r^2), and F came out with a relative error of eps r^2 / s^2 (all of it
-    // at s = 1e-8 r). With E_i the cross product is accurate to eps of its size, and
-    // F to about eps r / s.
-    double sum = 0;
-    for (size_t i = 0; i < clipped.size(); ++i) {
-        const Vec3& v_next = clipped[(i + 1) % clipped.size()];
-        const Vec3 r_i = clipped[i] - p;
-        const Vec3 c = cross(r_i, v_next - clipped[i]);
-        const double c_len = length(c);
-        if (c_len <= 0) continue;  // collinear with p: the edge contributes nothing
-        const double gamma = std::atan2(c_len, dot(r_i, v_next - p));  // angle between R_i, R_i+1
-        sum += gamma * dot(n_p, c) / c_len;
-    }
-    return std::fabs(sum) / (2 * Pi);
-}
 
 namespace {
 /// A dyadic cell of the shooter as one integer: level (5 bits), i and j (28 bits each).
@@ -424,7 +378,7 @@ Rgb IncrementIntegrator::cell_value(const SurfacePoint& p, const QuadCell& cell,
             case CellVisibility::clear: return sum_over(p, points(cell, n));
             case CellVisibility::cut: {
                 const std::uint64_t key = cell_key(cell);
-                if (cell.level < options_.min_cut_level && cell.level < options_.max_depth) {
+                if (cell.level < min_cut_level && cell.level < options_.max_depth) {
                     mixed_.push_back(key);  // split without integrating its pieces
                     return Rgb{};
                 }
@@ -517,7 +471,7 @@ IncrementIntegrator::Result IncrementIntegrator::integrate(const SurfacePoint& p
     const double scale = std::max(estimate, 1e-4 * unshot_bound_);
     // Singularity subtraction (QuadratureOptions::subtract): the constant B_h(x*) at the foot
     // x* of p carries the peak of F exactly; the rule integrates F (B_h - B_h(x*)).
-    double near_field = options_.near_field;
+    double near_field = near_field_guard;
     Rgb exact_part;
     if (planar_ && !unshot_constant_ && options_.subtract && allow_subtraction && !view_.use_rays) {
         const Vec2 uv = plane_.parameters(plane_.to_plane(p.position));
@@ -525,7 +479,7 @@ IncrementIntegrator::Result IncrementIntegrator::integrate(const SurfacePoint& p
         exact_part = visible_form_factor(p) * b_star;
         b_star_ = b_star;
         result.subtracted = b_star;
-        near_field = options_.near_field_subtracted;
+        near_field = near_field_guard_subtracted;
     }
     AdaptiveOptions opt;
     opt.n = options_.n;

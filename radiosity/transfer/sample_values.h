@@ -1,7 +1,7 @@
-// radiosity/transfer/sample_values.h - the kernel of the radiosity equation and the sample value of one energy
-// transfer (paper section 2, eqs. (2)-(4); section 4, eq. (21); section 6, "Adaptive
-// Quadrature"), and the analytic point-to-polygon form factor used as the exact reference
-// (section 7: "an analytic formula advocated in [7]", Baum, Rushmeier and Winget 1989).
+// radiosity/transfer/sample_values.h - the sample value of one energy transfer (paper section 4,
+// eq. (21); section 6, "Adaptive Quadrature"): the integral over the shooter of the kernel of
+// radiosity/transfer/form_factor.h, with exact visibility when asked
+// (radiosity/visibility/visible_parts.h).
 #pragma once
 
 #include <array>
@@ -12,31 +12,13 @@
 
 #include "math/convex2d.h"
 #include "math/gauss_legendre.h"
-#include "radiosity/visibility/visible_parts.h"
 #include "radiosity/geometry/spline_field.h"
 #include "radiosity/geometry/surface.h"
+#include "radiosity/transfer/form_factor.h"
+#include "radiosity/visibility/occlusion.h"
+#include "radiosity/visibility/visible_parts.h"
 
 namespace mbr {
-
-/// F(p, x) of eq. (3) for a receiving point p (normal n_p) and a shooting point x (normal n_x):
-/// [l . n_p][-l . n_x] / (pi |l|^4) with l = x - p, each cosine clamped at zero, so that a point
-/// behind either surface receives nothing (surfaces are one-sided).
-inline double form_factor_kernel(Vec3 p, Vec3 n_p, Vec3 x, Vec3 n_x) {
-    const Vec3 l = x - p;
-    const double cos_p = dot(l, n_p);   // |l| cos(theta_p)
-    const double cos_x = -dot(l, n_x);  // |l| cos(theta_x)
-    if (cos_p <= 0 || cos_x <= 0) return 0;
-    const double l2 = dot(l, l);
-    return cos_p * cos_x / (Pi * l2 * l2);
-}
-
-/// The form factor from a differential area at p (unit normal n_p) to a planar polygon, by
-/// Lambert's contour integral: F = |sum_i angle(R_i, R_{i+1}) n_p . unit(R_i x R_{i+1})| / (2 pi)
-/// with R_i = v_i - p. The polygon is one-sided like the surfaces: its front (counter-clockwise
-/// side) must face p, else F = 0. Parts behind p's tangent plane are clipped away first.
-/// Relative rounding error about eps r / s for a polygon of size s at distance r (the edge
-/// terms of order s / r cancel down to F), so a polygon 1e-9 of its distance keeps 7 digits.
-double point_polygon_form_factor(Vec3 p, Vec3 n_p, const std::vector<Vec3>& polygon);
 
 /// The shooting surface of one transfer and its unshot radiosity (already at the level the
 /// caller wants; section 6 coarsens it first).
@@ -44,6 +26,18 @@ struct Shooter {
     const Surface* surface = nullptr;
     SplineField unshot;
 };
+
+/// The near-field guard of the adaptive quadrature of (21): a shooter cell whose extent exceeds
+/// this many times its distance from the receiving point is split whatever its error estimate
+/// (0: never).
+constexpr double near_field_guard = 4.0;
+/// The near-field guard when the singularity is subtracted (QuadratureOptions::subtract; 0:
+/// off: the remainder has no peak a cell's nodes could miss).
+constexpr double near_field_guard_subtracted = 0;
+/// A shooter cell the horizon or a shadow cuts is split down to this level before its visible
+/// pieces are integrated (the root's pieces would be many; deeper cells are split by the error
+/// test when their pieces disagree).
+constexpr int min_cut_level = 1;
 
 /// Options of the adaptive quadrature of (21) over the shooter (section 6).
 struct QuadratureOptions {
@@ -55,8 +49,6 @@ struct QuadratureOptions {
     int max_depth = 24;           // cap on the shooter's subdivision (at most 28)
     int min_depth = 1;            // the whole shooter is never accepted as one cell
     double min_share = 1e-6;      // floor of a cell's share of the tolerance (math/gauss_legendre.h)
-    double near_field = 4.0;      // split a cell whose extent exceeds near_field times its
-                                  //   distance from the receiving point (0: never)
     bool global = false;          // refine the worst cell first until the error estimates sum
                                   //   to the tolerance (AdaptiveOptions::global), instead of
                                   //   the paper's quarter tolerance per child
@@ -70,18 +62,12 @@ struct QuadratureOptions {
                                   //   each cut cell's visible pieces are integrated
     int n_pieces = 0;             // the rule pair on cut cells' pieces: n_pieces against
                                   //   n_pieces + 1 points per triangle side (0: n, as cells)
-    int min_cut_level = 1;        // a cell the horizon or a shadow cuts is split down to this
-                                  //   level before its visible pieces are integrated (the
-                                  //   root's pieces would be many; deeper cells are split by
-                                  //   the error test when their pieces disagree)
     bool subtract = true;         // planar quad shooters of varying radiosity: I(p) =
                                   //   B_h(x*) F(p -> visible part) + int F (B_h - B_h(x*)),
                                   //   the first term by the contour formula (x* the foot of p
                                   //   on the shooter), so the peak of F near a receiving point
                                   //   close to the shooter (surfaces that meet) is exact and the
                                   //   remainder is nearly flat there
-    double near_field_subtracted = 0;  // the near-field guard when subtracting (0: off: the
-                                  //   remainder has no peak a cell's nodes could miss)
     bool clip_horizon = true;     // planar shooters: integrate cells the receiving point's
                                   //   tangent plane cuts over their front part only (exact
                                   //   convex pieces), instead of chasing the kink of the

@@ -1,16 +1,22 @@
 // radiosity/transfer/shadows.cpp - stage 7 of one transfer, the paper's shadows: visible fractions
 // (28) at fulcrums, shadow subdivision, and masking of the coefficients (section 5 "Adaptive
 // Subdivision in Shadow Computation", section 6 "Shadow"; DESIGN.md section 3, stage 7).
+#include "radiosity/transfer/shadows.h"
+
 #include <algorithm>
-#include <chrono>
 #include <cmath>
-#include <optional>
 #include <cstring>
+#include <map>
+#include <optional>
 #include <set>
+#include <vector>
 
 #include "math/check.h"
 #include "math/parallel.h"
-#include "radiosity/transfer/receiver.h"
+#include "radiosity/geometry/spline_field.h"
+#include "radiosity/transfer/projection.h"
+#include "radiosity/transfer/scale_adjustment.h"
+#include "radiosity/transfer/unification.h"
 
 namespace mbr {
 
@@ -38,11 +44,11 @@ double finest_domain_leaf(const Forest& forest) {
 int patch_depth(const ReceiverState& state) {
     const ShadowOptions& so = state.options.shadows;
     const double tau = state.options.absolute_tolerance;
-    if (tau <= 0 || state.max_sample <= 0) return so.min_patch_depth;
+    if (tau <= 0 || state.max_sample <= 0) return min_patch_depth;
     const double needed = std::pow(state.max_sample / (2 * tau), 2) / so.rays_per_patch;
     int d = 1;
-    while (d < so.min_patch_depth && std::pow(4.0, d) < needed) ++d;
-    return std::min(d, so.min_patch_depth);
+    while (d < min_patch_depth && std::pow(4.0, d) < needed) ++d;
+    return std::min(d, min_patch_depth);
 }
 
 /// Eq. (28) at the domain point (s, t), computed (no memo): rays to random points of every
@@ -67,8 +73,7 @@ Rgb compute_fraction(const ReceiverState& state, IncrementSampler& sampler, Vec2
         toward = occluders_toward(ctx, *plane, p.position, max_listed_occluders);
         if (toward.empty()) return {1, 1, 1};
     }
-    const IncrementIntegrator::Result r =
-        integrator.integrate(p, true, patch_depth(state), false);
+    const IncrementIntegrator::Result r = integrator.integrate(p, true, patch_depth(state), false);
     *n_evals += r.n_evaluations;
     const int n_rays_per_patch = state.options.shadows.rays_per_patch;
     const Surface& shooter = *sampler.shooter().surface;
@@ -172,38 +177,72 @@ double difference(Rgb a, Rgb b) {
     return max_abs(a - b);
 }
 
-}  // namespace
+/// "If the fraction corresponding to two adjacent fulcrums differs significantly, the
+/// corresponding subdomains are subdivided": the domain leaves (of `leaves`, whose fulcrums
+/// have fractions) between fulcrums whose fractions differ by more than the threshold. The
+/// fulcrums that split leaves are recorded in state.split_fulcrums.
+std::set<int> leaves_across_shadow_edges(ReceiverState& state, const std::vector<int>& leaves,
+                                         double threshold) {
+    const int m = state.options.m;
+    const ShadowOptions& so = state.options.shadows;
+    const Forest& forest = state.forest;
+    auto phi = [&](const Fulcrum& f) {
+        const Vec2 q = fraction_point(f, m);
+        return state.fractions.at({q.x, q.y});
+    };
 
-Vec2 fraction_point(const Fulcrum& f, int m) {
-    const Vec2 c = f.position(m);
-    return {std::clamp(c.x, 0.0, 1.0), std::clamp(c.y, 0.0, 1.0)};
+    std::set<int> marked;
+    for (int index : leaves) {
+        const DyadicCell c = forest.node(index).cell;
+        if (m % 2 == 0) {
+            // Adjacent fulcrums: the two ends of each edge of the leaf.
+            const std::vector<Fulcrum> f = leaf_fulcrums(c, m);  // (0,0) (1,0) (0,1) (1,1)
+            const int edges[4][2] = {{0, 1}, {1, 3}, {3, 2}, {2, 0}};
+            for (const auto& e : edges)
+                if (difference(phi(f[e[0]]), phi(f[e[1]])) > threshold) {
+                    marked.insert(index);
+                    if (c.level < so.max_depth) {
+                        state.split_fulcrums.push_back(fraction_point(f[e[0]], m));
+                        state.split_fulcrums.push_back(fraction_point(f[e[1]], m));
+                    }
+                }
+        } else {
+            // Adjacent fulcrums: the centres of leaves sharing an edge (each pair is seen
+            // from its finer leaf, or from both when they are of one size).
+            const Fulcrum own = leaf_fulcrums(c, m)[0];
+            const Rect r = c.rect();
+            const double d = 0.25 * c.size();
+            const Vec2 across[4] = {{r.x0 - d, 0.5 * (r.y0 + r.y1)},
+                                    {r.x1 + d, 0.5 * (r.y0 + r.y1)},
+                                    {0.5 * (r.x0 + r.x1), r.y0 - d},
+                                    {0.5 * (r.x0 + r.x1), r.y1 + d}};
+            for (const Vec2& q : across) {
+                if (q.x < 0 || q.x > 1 || q.y < 0 || q.y > 1) continue;
+                const int other = forest.leaf_at(q.x, q.y);
+                if (other < 0 || forest.node(other).cell.level > c.level) continue;
+                const Fulcrum of = leaf_fulcrums(forest.node(other).cell, m)[0];
+                if (!state.fractions.count({fraction_point(of, m).x, fraction_point(of, m).y}))
+                    continue;  // a leaf of an earlier round's scale adjustment: next round
+                if (difference(phi(own), phi(of)) > threshold) {
+                    marked.insert(index);
+                    marked.insert(other);
+                    state.split_fulcrums.push_back(fraction_point(own, m));
+                    state.split_fulcrums.push_back(fraction_point(of, m));
+                }
+            }
+        }
+    }
+    return marked;
 }
 
-Rgb fraction_at(ReceiverState& state, IncrementSampler& sampler, double s, double t, int thread) {
-    auto it = state.fractions.find({s, t});
-    if (it != state.fractions.end()) return it->second;
-    if (!state.occlusion) return {1, 1, 1};
-    long rays = 0, evals = 0;
-    const double inset = state.options.boundary_inset * finest_domain_leaf(state.forest);
-    const Rgb f = compute_fraction(state, sampler, {s, t}, inset, thread, &rays, &evals);
-    state.fractions[{s, t}] = f;
-    state.stats.n_rays += rays;
-    state.stats.n_kernel_evals += evals;
-    ++state.stats.n_fractions;
-    return f;
-}
-
-void apply_shadows(ReceiverState& state, IncrementSampler& sampler, const DualTable& dn) {
-    if (!state.occlusion) return;
-    const ReceiverOptions& opt = state.options;
-    const ShadowOptions& so = opt.shadows;
-    const int m = opt.m;
+/// Shadow subdivision (section 6, "Shadow"): fractions at every domain leaf's fulcrums; the
+/// leaves between differing ones split, scale-adjusted and resampled, round after round until
+/// none splits or all are at the maximum shadow depth. Returns the domain leaves it made.
+std::set<int> subdivide_shadows(ReceiverState& state, IncrementSampler& sampler, double inset,
+                                double threshold) {
+    const int m = state.options.m;
+    const ShadowOptions& so = state.options.shadows;
     Forest& forest = state.forest;
-    const double inset = opt.boundary_inset * finest_domain_leaf(forest);
-    // Fractions that differ by more than the threshold split, unless the difference they make
-    // is below the scene's absolute tolerance (a weak shot keeps coarse shadows).
-    const double threshold = std::max(so.threshold, state.max_sample > 0 ? opt.absolute_tolerance / state.max_sample : 0.0);
-
     std::set<int> new_leaves;  // domain leaves made by shadow subdivision (node indices)
     for (;;) {
         // Fractions at every domain leaf's fulcrums.
@@ -213,54 +252,7 @@ void apply_shadows(ReceiverState& state, IncrementSampler& sampler, const DualTa
             for (const Fulcrum& f : leaf_fulcrums(forest.node(index).cell, m))
                 points.push_back(fraction_point(f, m));
         compute_fractions(state, sampler, points, inset);
-        auto phi = [&](const Fulcrum& f) {
-            const Vec2 q = fraction_point(f, m);
-            return state.fractions.at({q.x, q.y});
-        };
-
-        // "If the fraction corresponding to two adjacent fulcrums differs significantly, the
-        // corresponding subdomains are subdivided."
-        std::set<int> marked;
-        for (int index : leaves) {
-            const DyadicCell c = forest.node(index).cell;
-            if (m % 2 == 0) {
-                // Adjacent fulcrums: the two ends of each edge of the leaf.
-                const std::vector<Fulcrum> f = leaf_fulcrums(c, m);  // (0,0) (1,0) (0,1) (1,1)
-                const int edges[4][2] = {{0, 1}, {1, 3}, {3, 2}, {2, 0}};
-                for (const auto& e : edges)
-                    if (difference(phi(f[e[0]]), phi(f[e[1]])) > threshold) {
-                        marked.insert(index);
-                        if (c.level < so.max_depth) {
-                            state.split_fulcrums.push_back(fraction_point(f[e[0]], m));
-                            state.split_fulcrums.push_back(fraction_point(f[e[1]], m));
-                        }
-                    }
-            } else {
-                // Adjacent fulcrums: the centres of leaves sharing an edge (each pair is seen
-                // from its finer leaf, or from both when they are of one size).
-                const Fulcrum own = leaf_fulcrums(c, m)[0];
-                const Rect r = c.rect();
-                const double d = 0.25 * c.size();
-                const Vec2 across[4] = {{r.x0 - d, 0.5 * (r.y0 + r.y1)},
-                                        {r.x1 + d, 0.5 * (r.y0 + r.y1)},
-                                        {0.5 * (r.x0 + r.x1), r.y0 - d},
-                                        {0.5 * (r.x0 + r.x1), r.y1 + d}};
-                for (const Vec2& q : across) {
-                    if (q.x < 0 || q.x > 1 || q.y < 0 || q.y > 1) continue;
-                    const int other = forest.leaf_at(q.x, q.y);
-                    if (other < 0 || forest.node(other).cell.level > c.level) continue;
-                    const Fulcrum of = leaf_fulcrums(forest.node(other).cell, m)[0];
-                    if (!state.fractions.count({fraction_point(of, m).x, fraction_point(of, m).y}))
-                        continue;  // a leaf of an earlier round's scale adjustment: next round
-                    if (difference(phi(own), phi(of)) > threshold) {
-                        marked.insert(index);
-                        marked.insert(other);
-                        state.split_fulcrums.push_back(fraction_point(own, m));
-                        state.split_fulcrums.push_back(fraction_point(of, m));
-                    }
-                }
-            }
-        }
+        const std::set<int> marked = leaves_across_shadow_edges(state, leaves, threshold);
         std::vector<int> to_split;
         for (int index : marked)
             if (forest.node(index).cell.level < so.max_depth) to_split.push_back(index);
@@ -277,7 +269,17 @@ void apply_shadows(ReceiverState& state, IncrementSampler& sampler, const DualTa
             if (forest.node(index).resampled) new_leaves.insert(index);
     }
 
-    // Projections on demand may now reach finer leaves: resampling tables for every level.
+    return new_leaves;
+}
+
+/// The new leaves' fulcrums, with their coefficients carried from the coarser ones by (17)
+/// ("During subdivision, (17) is applied to those projection coefficients computed in the
+/// previous section to obtain projection coefficients at a smaller scale"); projections on demand
+/// may now reach finer leaves, so the resampling tables cover every level.
+void carry_coefficients(ReceiverState& state, const DualTable& dn,
+                        const std::set<int>& new_leaves) {
+    const int m = state.options.m;
+    const Forest& forest = state.forest;
     if (!new_leaves.empty()) {
         int finest = 0;
         for (int index = 0; index < forest.n_nodes(); ++index)
@@ -286,9 +288,6 @@ void apply_shadows(ReceiverState& state, IncrementSampler& sampler, const DualTa
             make_projection_tables(m, dn, state.rhombus_radius, finest));
     }
 
-    // The new leaves' fulcrums: coefficients carried from the coarser ones by (17) ("During
-    // subdivision, (17) is applied to those projection coefficients computed in the previous
-    // section to obtain projection coefficients at a smaller scale").
     std::set<Fulcrum> added;
     for (int index : new_leaves) {
         if (!forest.node(index).is_leaf()) continue;
@@ -298,7 +297,7 @@ void apply_shadows(ReceiverState& state, IncrementSampler& sampler, const DualTa
     std::map<Fulcrum, Rgb> refined;
     for (const Fulcrum& f : added) {
         state.fulcrums.push_back(f);
-        if (!opt.unify_by_projection) {
+        if (!state.options.unify_by_projection) {
             const Rgb c = resolve_coefficient(state, dn, f, refined);
             state.coefficients[f] = c;
         }
@@ -307,9 +306,14 @@ void apply_shadows(ReceiverState& state, IncrementSampler& sampler, const DualTa
     state.fulcrums.erase(std::unique(state.fulcrums.begin(), state.fulcrums.end()),
                          state.fulcrums.end());
     state.stats.n_fulcrums = static_cast<int>(state.fulcrums.size());
+}
 
-    // "After subdivision, each resulting coefficient is multiplied by its corresponding
-    // fraction." An expanded fulcrum takes the fraction of the nearest point of the domain.
+/// "After subdivision, each resulting coefficient is multiplied by its corresponding
+/// fraction": every stored coefficient, and (through state.mask) those stage 8 projects on
+/// demand. An expanded fulcrum takes the fraction of the nearest point of the domain.
+void mask_coefficients(ReceiverState& state, IncrementSampler& sampler, double inset) {
+    const ReceiverOptions& opt = state.options;
+    const int m = opt.m;
     std::vector<Vec2> points;
     for (const auto& [f, c] : state.coefficients) points.push_back(fraction_point(f, m));
     // Stage 8 will project every finest-scale coefficient (unify_by_projection). For odd m
@@ -338,6 +342,41 @@ void apply_shadows(ReceiverState& state, IncrementSampler& sampler, const DualTa
         }
         return fraction_at(state, sampler, q.x, q.y, 0);
     };
+}
+
+}  // namespace
+
+Vec2 fraction_point(const Fulcrum& f, int m) {
+    const Vec2 c = f.position(m);
+    return {std::clamp(c.x, 0.0, 1.0), std::clamp(c.y, 0.0, 1.0)};
+}
+
+Rgb fraction_at(ReceiverState& state, IncrementSampler& sampler, double s, double t, int thread) {
+    auto it = state.fractions.find({s, t});
+    if (it != state.fractions.end()) return it->second;
+    if (!state.occlusion) return {1, 1, 1};
+    long rays = 0, evals = 0;
+    const double inset = boundary_inset * finest_domain_leaf(state.forest);
+    const Rgb f = compute_fraction(state, sampler, {s, t}, inset, thread, &rays, &evals);
+    state.fractions[{s, t}] = f;
+    state.stats.n_rays += rays;
+    state.stats.n_kernel_evals += evals;
+    ++state.stats.n_fractions;
+    return f;
+}
+
+void apply_shadows(ReceiverState& state, IncrementSampler& sampler, const DualTable& dn) {
+    if (!state.occlusion) return;
+    const ReceiverOptions& opt = state.options;
+    const double inset = boundary_inset * finest_domain_leaf(state.forest);
+    // Fractions that differ by more than the threshold split, unless the difference they make
+    // is below the scene's absolute tolerance (a weak shot keeps coarse shadows).
+    const double threshold =
+        std::max(opt.shadows.threshold,
+                 state.max_sample > 0 ? opt.absolute_tolerance / state.max_sample : 0.0);
+    const std::set<int> new_leaves = subdivide_shadows(state, sampler, inset, threshold);
+    carry_coefficients(state, dn, new_leaves);
+    mask_coefficients(state, sampler, inset);
 }
 
 }  // namespace mbr

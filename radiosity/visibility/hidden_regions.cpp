@@ -6,7 +6,7 @@
 
 #include "math/check.h"
 #include "math/parallel.h"
-#include "radiosity/visibility/visible_parts.h"
+#include "radiosity/visibility/occlusion.h"
 
 namespace mbr {
 

@@ -2,7 +2,7 @@
 // in Shadow Computation"; section 6, "Shadow" and "Octree"; eq. (28); DESIGN.md section 3,
 // stage 7).
 //
-// Two methods, chosen by ShadowOptions::method:
+// Two methods, chosen by ShadowOptions::method (radiosity/transfer/receiver_state.h):
 //   Fractions (the paper's, the default): the transfer is computed without shadows; then, for
 //     each selected fulcrum, rays are cast to every patch of the shooter partition that the
 //     adaptive quadrature of (21) formed for that point, the visible fraction is (28), leaves
@@ -25,65 +25,9 @@
 #include "math/convex2d.h"
 #include "octree/octree.h"
 #include "radiosity/geometry/surface.h"
+#include "radiosity/visibility/occlusion.h"
 
 namespace mbr {
-
-/// How visibility enters a transfer.
-enum class ShadowMethod {
-    None,       // VIS = 1
-    Fractions,  // the paper's: fractions (28) at fulcrums, shadow subdivision, masking
-    Exact       // VIS inside (21): the visible part of the shooter, projected like any samples
-};
-
-/// Options of the shadow stage.
-struct ShadowOptions {
-    ShadowMethod method = ShadowMethod::Fractions;
-    int rays_per_patch = 4;   // rays from a fulcrum to each patch of its shooter partition (28)
-    int min_patch_depth = 3;  // the partition of a fraction is at least this deep (the adaptive
-                              //   quadrature of (21) run with this minimum depth)
-    double threshold = 0.05;  // fractions of neighbouring fulcrums differing by more split the
-                              //   leaves between them (largest channel)
-    int max_depth = 6;        // shadow subdivision stops at leaves of this level
-    int max_node_depth = 10;  // Exact on a curved shooter: depth to which shooter cells whose
-                              //   quadrature nodes disagree on visibility are split
-};
-
-/// The occluders of one shooter -> receiver pair: the polygons (of an octree over the scene)
-/// that meet the convex hull of the two surfaces, other than the two surfaces' own.
-struct OcclusionContext {
-    const Octree* octree = nullptr;
-    int shooter_surface = -1;  // surface ids as the octree's polygons carry them
-    int receiver_surface = -1;
-    std::vector<int> candidates;  // polygon indices, increasing
-    std::uint64_t seed = 0;       // of every ray of the transfer: the pair and the shot number
-    int exact_limit = 24;         // exact visibility projects at most this many occluders for
-                                  //   one receiving point; beyond, one ray per quadrature node
-    /// True when nothing can come between the two surfaces.
-    bool clear() const { return candidates.empty(); }
-};
-
-/// The points whose convex hull holds a surface: the corners of a planar quad, else the eight
-/// corners of its bounding box.
-std::vector<Vec3> hull_points(const Surface& surface);
-
-/// The occluders between two surfaces, found with the octree (nodes and polygons outside the
-/// convex hull of both surfaces' hull_points are skipped). `shot` enters the seed.
-OcclusionContext make_occlusion_context(const Octree& octree, const Surface& shooter,
-                                        int shooter_surface, const Surface& receiver,
-                                        int receiver_surface, std::uint64_t shot);
-
-/// Up to this many occluders a segment is tested against the list one by one; beyond, the
-/// octree is faster (segment_blocked with a list, occluders_toward's limit).
-constexpr size_t max_listed_occluders = 32;
-
-/// True when an occluder of the context blocks the open segment a -> b (any-hit: a loop over
-/// the candidates when they are few, else the octree with the pair's own surfaces skipped; the
-/// answer is the same). Counts the ray in *n_rays.
-bool segment_blocked(const OcclusionContext& context, Vec3 a, Vec3 b, long* n_rays);
-/// The same against a subset of the candidates known to hold every polygon that can meet the
-/// segment (occluders_toward); an empty subset casts no ray.
-bool segment_blocked(const OcclusionContext& context, const std::vector<int>& occluders, Vec3 a,
-                     Vec3 b, long* n_rays);
 
 /// A planar quad shooter in a 2D frame of its plane: what exact visibility clips.
 struct ShooterPlane {
@@ -166,10 +110,5 @@ CellVisibility classify_cell(const ConvexPolygon& cell, const BlockedView& view,
                              bool* shadowed = nullptr);
 /// The visible part of a cut cell as disjoint convex pieces.
 std::vector<ConvexPolygon> visible_pieces(const ConvexPolygon& cell, const BlockedView& view);
-
-/// A reproducible 64-bit hash of a few integers (splitmix64 steps), for seeding rays.
-std::uint64_t hash_seed(std::uint64_t a, std::uint64_t b, std::uint64_t c = 0, std::uint64_t d = 0);
-/// A uniform double in [0, 1) from a counter (the hash of `key` and `index`).
-double uniform01(std::uint64_t key, std::uint64_t index);
 
 }  // namespace mbr

@@ -1,0 +1,32 @@
+// radiosity/transfer/form_factor.h - the kernel of the radiosity equation (paper section 2,
+// eqs. (2)-(4)) and the analytic point-to-polygon form factor used as the exact reference
+// (section 7: "an analytic formula advocated in [7]", Baum, Rushmeier and Winget 1989).
+#pragma once
+
+#include <vector>
+
+#include "math/vec3.h"
+
+namespace mbr {
+
+/// F(p, x) of eq. (3) for a receiving point p (normal n_p) and a shooting point x (normal n_x):
+/// [l . n_p][-l . n_x] / (pi |l|^4) with l = x - p, each cosine clamped at zero, so that a point
+/// behind either surface receives nothing (surfaces are one-sided).
+inline double form_factor_kernel(Vec3 p, Vec3 n_p, Vec3 x, Vec3 n_x) {
+    const Vec3 l = x - p;
+    const double cos_p = dot(l, n_p);   // |l| cos(theta_p)
+    const double cos_x = -dot(l, n_x);  // |l| cos(theta_x)
+    if (cos_p <= 0 || cos_x <= 0) return 0;
+    const double l2 = dot(l, l);
+    return cos_p * cos_x / (Pi * l2 * l2);
+}
+
+/// The form factor from a differential area at p (unit normal n_p) to a planar polygon, by
+/// Lambert's contour integral: F = |sum_i angle(R_i, R_{i+1}) n_p . unit(R_i x R_{i+1})| / (2 pi)
+/// with R_i = v_i - p. The polygon is one-sided like the surfaces: its front (counter-clockwise
+/// side) must face p, else F = 0. Parts behind p's tangent plane are clipped away first.
+/// Relative rounding error about eps r / s for a polygon of size s at distance r (the edge
+/// terms of order s / r cancel down to F), so a polygon 1e-9 of its distance keeps 7 digits.
+double point_polygon_form_factor(Vec3 p, Vec3 n_p, const std::vector<Vec3>& polygon);
+
+}  // namespace mbr

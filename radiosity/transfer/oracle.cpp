@@ -1,0 +1,220 @@
+// radiosity/transfer/oracle.cpp - stage 1 of one transfer: the oracle subdivision of [0,1]^2
+// (paper section 5, "Adaptive Subdivision of the Parametric Domain"; section 6, "Oracle").
+#include "radiosity/transfer/oracle.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <utility>
+#include <vector>
+
+#include "math/gauss_legendre.h"
+#include "math/parallel.h"
+#include "math/polynomial.h"
+#include "radiosity/transfer/gauss_points.h"
+
+namespace mbr {
+
+namespace {
+
+/// What the oracle needs on every cell: the options, the sampler, its two Gauss-Legendre rules
+/// (ceil(m/2) and m points), the scale of its tolerance floor, and the contact rule's plane.
+struct Oracle {
+    const ReceiverOptions& opt;
+    IncrementSampler& sampler;
+    GaussLegendre rule_c, rule_m;
+    std::vector<double> lagrange;  // [p * m + a]: the m-point interpolant at the rule_c nodes
+    double scale = 0;              // the largest root sample (0 when the bounds decide alone)
+    int min_depth = 0;             // the weak receiver rule may lower options' min_depth
+    const ShooterPlane* contact_plane = nullptr;  // a planar shooter, when the contact rule asks
+    bool contact_test = false;  // the contact oracle differs from the oracle's test
+};
+
+/// The mean of dB over a cell with an n x n rule; counts its (21) evaluations and, when asked,
+/// keeps the largest sample.
+Rgb cell_mean(IncrementSampler& sampler, const Rect& r, const GaussLegendre& rule, int thread,
+              long* evals, long* increments, double* largest = nullptr) {
+    Rgb sum;
+    double s[16], t[16];
+    gauss_points(r, rule, s, t);
+    for (int a = 0; a < rule.n(); ++a)
+        for (int b = 0; b < rule.n(); ++b) {
+            const Rgb v = sampler.sample(s[a], t[b], thread, evals);
+            if (largest) *largest = std::max(*largest, max_abs(v));
+            sum += (0.25 * rule.w[a] * rule.w[b]) * v;
+            ++*increments;
+        }
+    return sum;
+}
+
+/// The oracle's tolerance for values of the given magnitude. DESIGN: relative agreement, with a
+/// floor at 1% of the largest value in the domain so that nearly dark cells do not split
+/// forever, and never below the scene's absolute tolerance (its oracle_share).
+double oracle_tolerance(const Oracle& o, double magnitude) {
+    return std::max(o.opt.oracle_tolerance * std::max(magnitude, 0.01 * o.scale),
+                    oracle_share * o.opt.absolute_tolerance);
+}
+
+/// Section 6 "Oracle", the paper's test: the means of dB over the cell by ceil(m/2)^2 and by
+/// m^2 Gauss-Legendre points agree within the tolerance.
+bool two_means_agree(const Oracle& o, const Rect& r, int thread, long* evals, long* increments) {
+    const Rgb coarse = cell_mean(o.sampler, r, o.rule_c, thread, evals, increments);
+    const Rgb fine = cell_mean(o.sampler, r, o.rule_m, thread, evals, increments);
+    return max_abs(fine - coarse) <= oracle_tolerance(o, max_abs(fine));
+}
+
+/// Beyond the paper (OracleTest::Interpolation): the tensor polynomial through the m x m
+/// samples must predict the samples at the ceil(m/2)^2 points within the tolerance, point by
+/// point: a direct test of "can be approximated by a double (m-1)th order tensor product
+/// polynomial", which a kink of a shadow boundary fails even where the two means agree.
+bool interpolation_agrees(const Oracle& o, const Rect& r, int thread, long* evals,
+                          long* increments) {
+    const int m = o.rule_m.n(), nc = o.rule_c.n();
+    double s_m[16], t_m[16], s_c[16], t_c[16];
+    gauss_points(r, o.rule_m, s_m, t_m);
+    gauss_points(r, o.rule_c, s_c, t_c);
+    Rgb f_m[256], f_c[64];
+    double largest = 0;
+    for (int a = 0; a < m; ++a)
+        for (int b = 0; b < m; ++b) {
+            f_m[a * m + b] = o.sampler.sample(s_m[a], t_m[b], thread, evals);
+            largest = std::max(largest, max_abs(f_m[a * m + b]));
+        }
+    for (int a = 0; a < nc; ++a)
+        for (int b = 0; b < nc; ++b) {
+            f_c[a * nc + b] = o.sampler.sample(s_c[a], t_c[b], thread, evals);
+            largest = std::max(largest, max_abs(f_c[a * nc + b]));
+        }
+    *increments += m * m + nc * nc;
+    const double tol = oracle_tolerance(o, largest);
+    const std::vector<double>& L = o.lagrange;
+    for (int a = 0; a < nc; ++a)
+        for (int b = 0; b < nc; ++b) {
+            Rgb p;
+            for (int i = 0; i < m; ++i)
+                for (int j = 0; j < m; ++j) p += (L[a * m + i] * L[b * m + j]) * f_m[i * m + j];
+            if (max_abs(p - f_c[a * nc + b]) > tol) return false;
+        }
+    return true;
+}
+
+/// Distance from x to a planar shooter's closed polygon (its frame and outline).
+double distance_to_shooter(const ShooterPlane& plane, Vec3 x) {
+    const double height = dot(x - plane.origin, plane.normal);
+    const Vec2 q = plane.to_plane(x);
+    double across = 0;
+    if (!contains(plane.outline, q)) {
+        across = std::numeric_limits<double>::infinity();
+        const size_t n = plane.outline.size();
+        for (size_t k = 0; k < n; ++k) {
+            const Vec2 a = plane.outline[k], b = plane.outline[(k + 1) % n];
+            const Vec2 e = b - a;
+            const double len2 = dot(e, e);
+            const double t = len2 > 0 ? std::clamp(dot(q - a, e) / len2, 0.0, 1.0) : 0.0;
+            const Vec2 d = q - (a + t * e);
+            across = std::min(across, std::sqrt(dot(d, d)));
+        }
+    }
+    return std::sqrt(height * height + across * across);
+}
+
+/// The contact rule (beyond the paper, ReceiverOptions::contact_depth and contact_oracle_test):
+/// true when the receiver's cell comes within half its size of a planar shooter: its corners,
+/// edge midpoints and centre are tested (the contact lines of scenes are straight).
+bool touches_shooter(const Surface& receiver, const ShooterPlane& plane, const Rect& r) {
+    Vec3 p[9];
+    int k = 0;
+    for (double t : {r.y0, 0.5 * (r.y0 + r.y1), r.y1})
+        for (double s : {r.x0, 0.5 * (r.x0 + r.x1), r.x1})
+            p[k++] = receiver.evaluate(s, t).position;
+    const double size = std::max(length(p[8] - p[0]), length(p[6] - p[2]));
+    for (const Vec3& x : p)
+        if (distance_to_shooter(plane, x) <= 0.5 * size) return true;
+    return false;
+}
+
+/// The weak receiver rule (DESIGN, cost follows energy): a receiver whose largest root sample
+/// is below weak_receiver times the absolute tolerance starts the oracle at the root.
+int weak_receiver_min_depth(const ReceiverOptions& opt, double scale) {
+    if (opt.weak_receiver > 0 && opt.absolute_tolerance > 0 &&
+        scale < opt.weak_receiver * opt.absolute_tolerance)
+        return 0;
+    return opt.min_depth;
+}
+
+/// What the oracle does with one cell: keep it as a leaf, split it and ask again on its
+/// children, or split it once more and stop ("nearly sufficient").
+enum class OracleAction { Leaf, Split, SplitOnceMore };
+
+/// The oracle's decision on one cell: the depth bounds, the contact rule, then the test.
+OracleAction oracle_action(const Oracle& o, const DyadicCell& cell, long* evals, long* increments) {
+    const ReceiverOptions& opt = o.opt;
+    if (cell.level < o.min_depth) return OracleAction::Split;
+    // Whether the cell touches the shooter, asked only when an answer matters.
+    const bool ask = o.contact_plane && (cell.level < opt.contact_depth ||
+                                         (o.contact_test && cell.level < opt.max_depth));
+    const bool contact =
+        ask && touches_shooter(*o.sampler.receiver().surface, *o.contact_plane, cell.rect());
+    if (cell.level < opt.contact_depth && contact) return OracleAction::Split;
+    if (cell.level >= opt.max_depth) return OracleAction::Leaf;
+    const int th = thread_index();
+    // DESIGN: a cell touching the shooter takes contact_oracle_test (`set contact_oracle
+    // interpolation`): there dB grows like d log d, whose two means agree long before the
+    // spline can follow it.
+    const OracleTest test = contact ? opt.contact_oracle_test : opt.oracle_test;
+    const bool agree = test == OracleTest::Interpolation
+                           ? interpolation_agrees(o, cell.rect(), th, evals, increments)
+                           : two_means_agree(o, cell.rect(), th, evals, increments);
+    return agree ? OracleAction::SplitOnceMore : OracleAction::Split;
+}
+
+}  // namespace
+
+void subdivide_by_oracle(ReceiverState& state, IncrementSampler& sampler) {
+    const ReceiverOptions& opt = state.options;
+    const int m = opt.m;
+    Forest& forest = state.forest;
+    TransferStats& stats = state.stats;
+    Oracle o{opt, sampler, gauss_legendre((m + 1) / 2), gauss_legendre(m), {}};
+    const std::vector<double> c_nodes(o.rule_c.x.begin(), o.rule_c.x.end());
+    o.lagrange = lagrange_matrix(o.rule_m, c_nodes);
+
+    // Scale for the oracle's floor: the largest of the m x m samples of the whole domain
+    // (not needed when the bounds leave the oracle nothing to decide).
+    if (opt.min_depth < opt.max_depth) {
+        long evals = 0, increments = 0;
+        cell_mean(sampler, Rect{0, 1, 0, 1}, o.rule_m, 0, &evals, &increments, &o.scale);
+        stats.n_kernel_evals += evals;
+        stats.n_increments += increments;
+        stats.n_oracle_increments += increments;
+    }
+    o.min_depth = weak_receiver_min_depth(opt, o.scale);
+    // The shooter's plane when it is planar (the contact rule).
+    o.contact_test = opt.contact_oracle_test != opt.oracle_test;
+    if (opt.contact_depth > 0 || o.contact_test)
+        o.contact_plane = sampler.integrator(0).shooter_plane();
+
+    std::vector<int> frontier{forest.domain_root()};
+    while (!frontier.empty()) {
+        const int n = static_cast<int>(frontier.size());
+        std::vector<OracleAction> action(n, OracleAction::Leaf);
+        std::vector<long> evals(n, 0), increments(n, 0);
+        parallel_for(n, [&](int c) {
+            action[c] = oracle_action(o, forest.node(frontier[c]).cell, &evals[c], &increments[c]);
+        });
+        std::vector<int> next;
+        for (int c = 0; c < n; ++c) {
+            stats.n_kernel_evals += evals[c];
+            stats.n_increments += increments[c];
+            stats.n_oracle_increments += increments[c];
+            if (action[c] == OracleAction::Leaf) continue;
+            const int first = forest.split(frontier[c]);
+            if (action[c] == OracleAction::Split)
+                for (int ch = 0; ch < 4; ++ch) next.push_back(first + ch);
+            // SplitOnceMore: "nearly sufficient ... stopped after once more": children are leaves.
+        }
+        frontier = std::move(next);
+    }
+}
+
+}  // namespace mbr

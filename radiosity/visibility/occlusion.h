@@ -1,0 +1,61 @@
+// radiosity/visibility/occlusion.h - the occluders of one shooter -> receiver pair and the
+// shadow rays between them (paper section 6, "Octree": a pair that no polygon can come between
+// casts no rays; "Shadow": the rays of eq. (28)), with the reproducible seeds of those rays.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "math/vec3.h"
+#include "octree/octree.h"
+#include "radiosity/geometry/surface.h"
+
+namespace mbr {
+
+/// The occluders of one shooter -> receiver pair: the polygons (of an octree over the scene)
+/// that meet the convex hull of the two surfaces, other than the two surfaces' own.
+struct OcclusionContext {
+    const Octree* octree = nullptr;
+    int shooter_surface = -1;  // surface ids as the octree's polygons carry them
+    int receiver_surface = -1;
+    std::vector<int> candidates;  // polygon indices, increasing
+    std::uint64_t seed = 0;       // of every ray of the transfer: the pair and the shot number
+    /// True when nothing can come between the two surfaces.
+    bool clear() const { return candidates.empty(); }
+};
+
+/// The points whose convex hull holds a surface: the corners of a planar quad, else the eight
+/// corners of its bounding box.
+std::vector<Vec3> hull_points(const Surface& surface);
+
+/// The occluders between two surfaces, found with the octree (nodes and polygons outside the
+/// convex hull of both surfaces' hull_points are skipped). `shot` enters the seed.
+OcclusionContext make_occlusion_context(const Octree& octree, const Surface& shooter,
+                                        int shooter_surface, const Surface& receiver,
+                                        int receiver_surface, std::uint64_t shot);
+
+/// Up to this many occluders a segment is tested against the list one by one; beyond, the
+/// octree is faster (segment_blocked with a list, occluders_toward's limit).
+constexpr size_t max_listed_occluders = 32;
+
+/// Exact visibility projects at most this many occluders for one receiving point: a pair with
+/// more candidates keeps those that meet the point's pyramid to the shooter (occluders_toward);
+/// still more, and visibility is one ray per quadrature node (BlockedView::use_rays).
+constexpr int exact_limit = 24;
+
+/// True when an occluder of the context blocks the open segment a -> b (any-hit: a loop over
+/// the candidates when they are few, else the octree with the pair's own surfaces skipped; the
+/// answer is the same). Counts the ray in *n_rays.
+bool segment_blocked(const OcclusionContext& context, Vec3 a, Vec3 b, long* n_rays);
+/// The same against a subset of the candidates known to hold every polygon that can meet the
+/// segment (occluders_toward); an empty subset casts no ray.
+bool segment_blocked(const OcclusionContext& context, const std::vector<int>& occluders, Vec3 a,
+                     Vec3 b, long* n_rays);
+
+/// A reproducible 64-bit hash of a few integers (splitmix64 steps), for seeding rays.
+std::uint64_t hash_seed(std::uint64_t a, std::uint64_t b, std::uint64_t c = 0, std::uint64_t d = 0);
+/// A uniform double in [0, 1) from a counter (the hash of `key` and `index`).
+double uniform01(std::uint64_t key, std::uint64_t index);
+
+}  // namespace mbr
