@@ -1,0 +1,263 @@
+// test/test_occlusion.cpp - the occluders of a pair and the octree queries under them (paper
+// section 6, "Octree"; radiosity/visibility/occlusion.h): make_occlusion_context, segment_blocked,
+// any_hit with a RayFilter and polygons_near against brute force.
+#include <algorithm>
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <random>
+#include <set>
+#include <vector>
+
+#include "math/bspline.h"
+#include "math/gauss_legendre.h"
+#include "radiosity/reference/configurations.h"
+#include "radiosity/transfer/sample_values.h"
+#include "radiosity/transfer/transfer.h"
+#include "radiosity/visibility/occlusion.h"
+#include "radiosity/visibility/visible_parts.h"
+#include "test/report.h"
+#include "test/shadow_scenes.h"
+
+using namespace mbr;
+using namespace mbr::test;
+
+// ---- The occluders of a pair and the octree queries under them ---------------------------------
+
+TEST_CASE("shadow: any_hit with a RayFilter equals brute force over the unfiltered polygons",
+          "[shadow][occlusion]") {
+    // Random polygons of six surfaces, random rays with random [t_min, t_max]; for each filter the
+    // octree's answer must be "some polygon of a surface not skipped is hit in range", which a
+    // loop over all polygons with Polygon::intersect decides. Exact agreement: both use the same
+    // ray-polygon test, and the octree's margins make it never miss a listed hit.
+    const unsigned seed = 909;
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> u(0, 4);
+    std::uniform_int_distribution<int> surface(0, 5);
+    std::vector<Polygon> scene;
+    for (int i = 0; i < 400; ++i) {
+        const Vec3 c{u(rng), u(rng), u(rng)};
+        const int s = surface(rng);
+        scene.push_back(make_polygon(
+            i % 2 ? random_parallelogram(rng, c, 0.6) : random_triangle(rng, c, 0.8), s));
+    }
+    const Octree octree(scene, OctreeOptions{8, 4});
+    const RayFilter filters[] = {RayFilter{}, RayFilter{0, -1}, RayFilter{-1, 3}, RayFilter{2, 4},
+                                 RayFilter{5, 5}};
+    long n_hits[5] = {0, 0, 0, 0, 0}, n_differ_by_filter = 0;
+    for (int r = 0; r < 1500; ++r) {
+        const Vec3 a{u(rng), u(rng), u(rng)}, b{u(rng), u(rng), u(rng)};
+        const double t0 = 0.25 * u(rng) / 4, t1 = 1 - 0.25 * u(rng) / 4;
+        const Ray ray{a, b - a, t0, t1};
+        bool previous = false;
+        for (int f = 0; f < 5; ++f) {
+            bool brute = false;
+            for (const Polygon& p : scene)
+                if (!filters[f].skips(p.surface()) && p.intersect(ray)) brute = true;
+            CAPTURE(seed, r, f, ray);
+            CHECK(octree.any_hit(ray, filters[f]) == brute);
+            n_hits[f] += brute;
+            if (f > 0 && brute != previous) ++n_differ_by_filter;
+            previous = brute;
+        }
+        CHECK(octree.any_hit(ray) == octree.any_hit(ray, RayFilter{}));
+    }
+    // The filters matter: hits do occur, and differ between filters on some rays.
+    CHECK(n_hits[0] > 300);
+    CHECK(n_hits[3] < n_hits[0]);
+    CHECK(n_differ_by_filter > 50);
+}
+
+TEST_CASE("shadow: polygons_near equals the leaves' lists brute-forced over node tests",
+          "[shadow][occlusion]") {
+    // polygons_near(test) must be the union of the lists of the leaves whose grown cube and whose
+    // ancestors' grown cubes the test accepts. The tree is read back through polygons_near itself:
+    // an accept-all test records every node's grown cube (leaves are the cubes containing no
+    // smaller recorded cube), and "cube contains leaf L" returns exactly L's list. Then random box
+    // queries are compared with the union over the leaves, and with exact clipping: a polygon
+    // that truly meets the box is never missing (it meets the box in some leaf's cube).
+    const unsigned seed = 4242;
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> u(0, 4);
+    std::vector<Polygon> scene;
+    for (int i = 0; i < 250; ++i) {
+        const Vec3 c{u(rng), u(rng), u(rng)};
+        scene.push_back(make_polygon(random_parallelogram(rng, c, 0.7), i % 3));
+    }
+    const Octree octree(scene, OctreeOptions{6, 4});
+    std::vector<Box3> cubes;
+    const std::vector<int> all = octree.polygons_near([&](const Box3& b) {
+        cubes.push_back(b);
+        return true;
+    });
+    CHECK(all.size() == scene.size());  // every polygon is listed by some leaf
+    REQUIRE(static_cast<int>(cubes.size()) == octree.node_count());
+    auto contains = [](const Box3& outer, const Box3& inner) {
+        return outer.lo.x <= inner.lo.x && outer.lo.y <= inner.lo.y && outer.lo.z <= inner.lo.z &&
+               inner.hi.x <= outer.hi.x && inner.hi.y <= outer.hi.y && inner.hi.z <= outer.hi.z;
+    };
+    auto side = [](const Box3& b) { return b.hi.x - b.lo.x; };
+    struct Leaf {
+        Box3 cube;
+        std::vector<int> ancestors;  // indices into cubes
+        std::vector<int> polygons;
+    };
+    std::vector<Leaf> leaves;
+    for (size_t i = 0; i < cubes.size(); ++i) {
+        bool leaf = true;
+        std::vector<int> ancestors;
+        for (size_t j = 0; j < cubes.size(); ++j) {
+            if (j == i) continue;
+            if (side(cubes[j]) < side(cubes[i]) && contains(cubes[i], cubes[j])) leaf = false;
+            if (side(cubes[j]) > side(cubes[i]) && contains(cubes[j], cubes[i]))
+                ancestors.push_back(int(j));
+        }
+        if (!leaf) continue;
+        const Box3 cube = cubes[i];
+        std::vector<int> list =
+            octree.polygons_near([&](const Box3& b) { return contains(b, cube); });
+        // A leaf lists only polygons the node test accepts for its grown cube (the build filters
+        // each child's list with it).
+        for (int id : list) CHECK(node_meets_polygon(cube, scene[id]));
+        leaves.push_back({cube, ancestors, list});
+    }
+    CHECK(static_cast<int>(leaves.size()) == octree.leaf_count());
+
+    long n_results = 0, n_over = 0;
+    for (int q = 0; q < 200; ++q) {
+        const Vec3 lo{u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5};
+        const double s = 0.1 + 0.4 * u(rng);
+        const Box3 box{lo, lo + Vec3{s, 0.7 * s, 1.3 * s}};
+        auto test = [&](const Box3& b) { return overlaps(b, box); };
+        const std::vector<int> got = octree.polygons_near(test);
+        std::set<int> expected;
+        for (const Leaf& leaf : leaves) {
+            bool accepted = test(leaf.cube);
+            for (int a : leaf.ancestors) accepted = accepted && test(cubes[a]);
+            if (accepted) expected.insert(leaf.polygons.begin(), leaf.polygons.end());
+        }
+        CAPTURE(seed, q, box);
+        CHECK(got == std::vector<int>(expected.begin(), expected.end()));
+        for (int id = 0; id < static_cast<int>(scene.size()); ++id) {
+            const bool meets = polygon_meets_box(scene[id].vertices(), box);
+            const bool listed = std::binary_search(got.begin(), got.end(), id);
+            if (meets) CHECK(listed);
+            n_over += listed && !meets;
+        }
+        n_results += static_cast<long>(got.size());
+    }
+    CHECK(n_results > 500);
+    mbr::test::report() << "shadow polygons_near: " << octree.node_count() << " nodes, "
+                        << leaves.size() << " leaves; 200 box queries returned " << n_results
+                        << " polygons, " << n_over << " of them not meeting the box\n";
+}
+
+TEST_CASE("shadow: make_occlusion_context finds every polygon that meets the pair's hull",
+          "[shadow][occlusion]") {
+    // Random shooter and receiver quads (and, every fourth time, a cylinder patch as the
+    // receiver: its hull points are its bounding box's corners) with random occluders around
+    // them. Brute force: a polygon meets the convex hull of hull_points(shooter) and
+    // hull_points(receiver) iff no separating axis exists (hull_polygon_gap). A polygon
+    // meeting it by more than 1e-7 (the library drops polygons within 1e-9 x the coordinates of
+    // the hull's boundary) must be a candidate: no false negatives ever. False positives (listed,
+    // but apart) only cost rays; they are counted. The two surfaces' own polygons never are.
+    const unsigned seed = 123;
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> u(0, 1);
+    long n_meet = 0, n_apart = 0, n_false_positive = 0, n_ambiguous = 0;
+    for (int config = 0; config < 120; ++config) {
+        const Surface shooter =
+            quad_surface(random_parallelogram(rng, {u(rng), u(rng), u(rng)}, 1));
+        Surface receiver = quad_surface(random_parallelogram(rng, {u(rng), u(rng), u(rng)}, 1));
+        if (config % 4 == 3) {
+            const Vec3 base{u(rng), u(rng), u(rng)};
+            const Vec3 axis = random_unit(rng);
+            receiver = Surface::cylinder(base, axis, Vec3{1, 0, 0}, 0.3, 0.6, 0, 2);
+        }
+        std::vector<Polygon> polygons;
+        polygons.push_back(make_polygon(quad_polygon(shooter), 0));
+        for (const Facet& f : receiver.tessellate(4))
+            polygons.push_back(make_polygon(f.vertices, 1));
+        std::vector<std::vector<Vec3>> occluders;
+        for (int i = 0; i < 25; ++i) {
+            const Vec3 c{1.6 * u(rng) - 0.3, 1.6 * u(rng) - 0.3, 1.6 * u(rng) - 0.3};
+            occluders.push_back(i % 2 ? random_parallelogram(rng, c, 0.4)
+                                      : random_triangle(rng, c, 0.5));
+            polygons.push_back(make_polygon(occluders.back(), 2 + i));
+        }
+        const int first_occluder = static_cast<int>(polygons.size()) - 25;
+        const Octree octree(polygons, OctreeOptions{6, 4});
+        const OcclusionContext ctx =
+            make_occlusion_context(octree, shooter, 0, receiver, 1, config);
+        CHECK(std::is_sorted(ctx.candidates.begin(), ctx.candidates.end()));
+        std::vector<Vec3> pts = hull_points(shooter);
+        for (const Vec3& q : hull_points(receiver)) pts.push_back(q);
+        for (int id : ctx.candidates) CHECK(octree.polygons()[id].surface() >= 2);
+        for (int i = 0; i < 25; ++i) {
+            const int id = first_occluder + i;
+            const double gap = hull_polygon_gap(pts, occluders[i]);
+            const bool listed =
+                std::binary_search(ctx.candidates.begin(), ctx.candidates.end(), id);
+            CAPTURE(seed, config, i, gap);
+            if (gap < -1e-7) {
+                ++n_meet;
+                CHECK(listed);
+            } else if (gap > 1e-7) {
+                ++n_apart;
+                n_false_positive += listed;
+            } else {
+                ++n_ambiguous;
+            }
+        }
+    }
+    CHECK(n_meet > 300);
+    CHECK(n_apart > 300);
+    mbr::test::report() << "shadow make_occlusion_context: " << n_meet << " occluders meet the hull"
+                        << " (all listed), " << n_apart << " are apart, of which "
+                        << n_false_positive << " listed (false positives), " << n_ambiguous
+                        << " within 1e-7 of touching\n";
+}
+
+TEST_CASE("shadow: segment_blocked equals brute force with few and with many candidates",
+          "[shadow][occlusion]") {
+    // segment_blocked loops over the candidates when there are at most 16, else asks the octree
+    // with the pair's surfaces filtered out. Both must equal "some polygon other than the two
+    // surfaces' crosses the open segment", for segments between points of the two surfaces.
+    const unsigned seed = 5;
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> u(0, 1);
+    int n_few = 0, n_many = 0;
+    long n_blocked = 0, n_segments = 0;
+    for (int config = 0; config < 12; ++config) {
+        const int n_occluders = config % 2 ? 6 : 60;
+        ShadowSetup setup = occluded_squares(0);
+        setup.occluders.clear();
+        for (int i = 0; i < n_occluders; ++i) {
+            const Vec3 c{u(rng), u(rng), 0.1 + 0.8 * u(rng)};
+            setup.occluders.push_back(random_parallelogram(rng, c, n_occluders > 10 ? 0.15 : 0.3));
+        }
+        const Pair pair(setup, config);
+        const bool many = pair.context.candidates.size() > 16;
+        (many ? n_many : n_few) += 1;
+        for (int s = 0; s < 300; ++s) {
+            const double ua = u(rng), va = u(rng), ub = u(rng), vb = u(rng);
+            const Vec3 a = setup.shooter.point(ua, va), b = setup.receiver.point(ub, vb);
+            const Ray ray{a, b - a, 1e-9, 1 - 1e-9};
+            bool brute = false;
+            for (const Polygon& p : pair.octree.polygons())
+                if (p.surface() >= 2 && p.intersect(ray)) brute = true;
+            long n_rays = 0;
+            CAPTURE(seed, config, s);
+            CHECK(segment_blocked(pair.context, a, b, &n_rays) == brute);
+            CHECK(n_rays == 1);
+            n_blocked += brute;
+            ++n_segments;
+        }
+    }
+    CHECK(n_few > 0);
+    CHECK(n_many > 0);
+    CHECK(n_blocked > n_segments / 10);
+    CHECK(n_blocked < n_segments);
+}
