@@ -90,11 +90,10 @@ Explained explain(const TransferSetup& setup, const std::string& geometry,
     const Shooter shooter = make_shooter(setup.shooter, unshot, options.shooter_coarsening);
     const ReceiverSurface receiver{&setup.receiver, [](double, double) { return Rgb{1, 1, 1}; }};
 
-    // The stages of transfer() (radiosity/transfer/receiver.h), one at a time.
-    ReceiverState& state = out.state;
-    state.options = options;
+    // The stages of transfer() (radiosity/transfer/transfer.h), one at a time.
     const DualTable dn(options.m);
-    state.rhombus_radius = rhombus_radius_cells(options, dn);
+    out.state = ReceiverState(options, rhombus_radius_cells(options, dn));
+    ReceiverState& state = out.state;
     state.stats.rhombus_radius = state.rhombus_radius;
     IncrementSampler sampler(shooter, receiver, options.quadrature);
 
@@ -376,276 +375,331 @@ Window zoom_window(const Explained& E) {
     return {centre.x - half, centre.x + half, centre.y - half, centre.y + half};
 }
 
-Image compose(const Explained& E, const Counts& counts, int chosen) {
-    const ReceiverState& st = E.state;
-    const Forest& forest = st.forest;
-    const int m = st.options.m;
-    const int K = forest.extent();
-    const int s = 2, pad = 16 * s;
-    const int area = 620;
-    const int margin = axes_margin(s, 4);
-    const int title_h = 3 * glyph_line_height * s;
-    const int panel_w = margin + area + pad, panel_h = title_h + area + margin;
-    const int width = 2 * panel_w + pad;
-    const int legend_h = 330;
+// The sheet compose() draws: four panels in two rows under a header, a legend below; what the
+// panels show (the explained transfer, its counts, the chosen fulcrum) and the layout they share.
+struct Sheet {
+    Sheet(const Explained& E_, const Counts& counts_, int chosen_);
+    Sheet(const Sheet&) = delete;  // the canvas draws into this sheet's image
+    Sheet& operator=(const Sheet&) = delete;
 
-    int finest = 0, coarsest = 1 << 20;
-    for (const Fulcrum& f : st.fulcrums)
-        finest = std::max(finest, f.level), coarsest = std::min(coarsest, f.level);
-    MarkerStyle style;
-    style.finest = finest;
+    void header();
+    void quadtree_panel(const Window& view_a, const Window& view_c);  // (a)
+    void expanded_panel(const Window& view_a);                        // (b)
+    void zoom_panel(const Window& view_c);                            // (c)
+    void rhombus_panel();                                             // (d)
+    void level_legend();  // the legend's left column: levels, hatching, marks
+    void map_scale();     // its right column: the colour scale of panel (d)
 
-    const std::string title = "One transfer, stage by stage: " + E.geometry;
-    const std::vector<std::string> subtitle =
-        wrap_text(describe(st.options) + "; oracle depths " + std::to_string(st.options.min_depth) +
-                      ".." + std::to_string(st.options.max_depth) + ", tolerance " +
-                      cell_g(st.options.oracle_tolerance, 3) +
-                      "; rea = " + cell_g(100 * E.errors.rea, 3) + " %.",
-                  width - 2 * pad, s);
-    const int header_h =
-        pad / 2 + glyph_line_height * 3 + int(subtitle.size()) * glyph_line_height * s + pad / 2;
-    Image image(width, header_h + 2 * panel_h + legend_h, {1, 1, 1});
-    Canvas canvas(image);
-    canvas.text(pad, pad / 2, title, ink, 3);
-    for (size_t i = 0; i < subtitle.size(); ++i)
-        canvas.text(pad, pad / 2 + glyph_line_height * 3 + int(i) * glyph_line_height * s,
-                    subtitle[i], ink, s);
-
-    auto panel_area = [&](int column, int row) {
+    PixelRect panel_area(int column, int row) const {
         return PixelRect{column * panel_w + pad + margin, header_h + row * panel_h + title_h, area,
                          area};
-    };
-    auto panel_title = [&](const PixelRect& a, const std::string& t1, const std::string& t2) {
+    }
+    void panel_title(const PixelRect& a, const std::string& t1, const std::string& t2) {
         canvas.text(a.x + a.w / 2, a.y - 2 * glyph_line_height * s + 2, t1, ink, s + 1,
                     Align::centre, Align::end);
         canvas.text(a.x + a.w / 2, a.y - glyph_line_height * s / 2, t2, {0.3, 0.3, 0.3}, s,
                     Align::centre, Align::end);
-    };
-    auto square_layout = [&](const PixelRect& a, const Window& w) {
+    }
+    PlotLayout square_layout(const PixelRect& a, const Window& w) const {
         return map_layout(a, w.s0, w.s1, w.t0, w.t1, s);
+    }
+
+    const Explained& E;
+    const Counts& counts;
+    const int chosen;
+    const ReceiverState& st;
+    const Forest& forest;
+    const int m, K;
+    const int s = 2, pad = 16 * s;
+    const int area = 620;
+    const int margin, title_h, panel_w, panel_h, width;
+    const int legend_h = 330;
+    int finest = 0, coarsest = 1 << 20;
+    MarkerStyle style;
+    const std::vector<std::string> subtitle;
+    const int header_h;
+    Image image;
+    Canvas canvas;  // draws into image
+    const Fulcrum& cf;
+    const Vec2 chosen_q;
+    const double cell_size;
+    const double R;  // the chosen fulcrum's rhombus radius in parameter units
+};
+
+// The sheet's subtitle: the options and the result, wrapped to `width` pixels at scale s.
+std::vector<std::string> sheet_subtitle(const Explained& E, int width, int s) {
+    const ReceiverOptions& o = E.state.options;
+    return wrap_text(describe(o) + "; oracle depths " + std::to_string(o.min_depth) + ".." +
+                         std::to_string(o.max_depth) + ", tolerance " +
+                         cell_g(o.oracle_tolerance, 3) + "; rea = " +
+                         cell_g(100 * E.errors.rea, 3) + " %.",
+                     width, s);
+}
+
+Sheet::Sheet(const Explained& E_, const Counts& counts_, int chosen_)
+    : E(E_),
+      counts(counts_),
+      chosen(chosen_),
+      st(E_.state),
+      forest(E_.state.forest),
+      m(E_.state.options.m),
+      K(E_.state.forest.extent()),
+      margin(axes_margin(s, 4)),
+      title_h(3 * glyph_line_height * s),
+      panel_w(margin + area + pad),
+      panel_h(title_h + area + margin),
+      width(2 * panel_w + pad),
+      subtitle(sheet_subtitle(E_, width - 2 * pad, s)),
+      header_h(pad / 2 + glyph_line_height * 3 + int(subtitle.size()) * glyph_line_height * s +
+               pad / 2),
+      image(width, header_h + 2 * panel_h + legend_h, {1, 1, 1}),
+      canvas(image),
+      cf(E_.state.fulcrums[chosen_]),
+      chosen_q(cf.position(m)),
+      cell_size(std::ldexp(1.0, -cf.level)),
+      R(st.rhombus_radius * cell_size) {
+    for (const Fulcrum& f : st.fulcrums)
+        finest = std::max(finest, f.level), coarsest = std::min(coarsest, f.level);
+    style.finest = finest;
+}
+
+void Sheet::header() {
+    const std::string title = "One transfer, stage by stage: " + E.geometry;
+    canvas.text(pad, pad / 2, title, ink, 3);
+    for (size_t i = 0; i < subtitle.size(); ++i)
+        canvas.text(pad, pad / 2 + glyph_line_height * 3 + int(i) * glyph_line_height * s,
+                    subtitle[i], ink, s);
+}
+
+// (a) The domain and a strip of the ring around it.
+void Sheet::quadtree_panel(const Window& view_a, const Window& view_c) {
+    const PixelRect a = panel_area(0, 0);
+    const PlotLayout L = square_layout(a, view_a);
+    canvas.set_clip(a);
+    draw_leaves(canvas, L, forest, 0.30, 4, leaf_line);
+    hatch_adjusted(canvas, L, E);
+    draw_patches(canvas, L, K, 3);
+    draw_fulcrums(canvas, L, st.fulcrums, m, style);
+    mark_chosen(canvas, L, chosen_q, chosen, s);
+    mark_window(canvas, L, view_c, "(c)", s);
+    canvas.reset_clip();
+    draw_axes(image, L, "s", "t", ink, s);
+    panel_title(a, "(a) quadtree and fulcrums",
+                "domain + inner " + cell_g(-view_a.s0, 2) + " of the ring; colour: level");
+}
+
+// (b) The whole expanded domain.
+void Sheet::expanded_panel(const Window& view_a) {
+    const PixelRect a = panel_area(1, 0);
+    const Window w{-double(K), 1.0 + K, -double(K), 1.0 + K};
+    const PlotLayout L = square_layout(a, w);
+    canvas.set_clip(a);
+    draw_leaves(canvas, L, forest, 0.45, 5, {0.55, 0.55, 0.55});
+    draw_patches(canvas, L, K, 4);
+    mark_window(canvas, L, view_a, "(a)", s);
+    canvas.reset_clip();
+    draw_axes(image, L, "s", "t", ink, s);
+    panel_title(a, "(b) expanded domain: eight patches",
+                "whole ring, " + std::to_string(K) + " units wide; numbered as in Figure 5");
+}
+
+// (c) Zoom where two sizes meet.
+void Sheet::zoom_panel(const Window& view_c) {
+    const PixelRect a = panel_area(0, 1);
+    const PlotLayout L = square_layout(a, view_c);
+    MarkerStyle big = style;
+    big.radius = 6;
+    big.step = 7;
+    canvas.set_clip(a);
+    draw_leaves(canvas, L, forest, 0.30, 4, leaf_line);
+    hatch_adjusted(canvas, L, E);
+    draw_patches(canvas, L, K, 3);
+    draw_fulcrums(canvas, L, st.fulcrums, m, big);
+    mark_chosen(canvas, L, chosen_q, chosen, s);
+    canvas.reset_clip();
+    draw_axes(image, L, "s", "t", ink, s);
+    panel_title(a, "(c) zoom: two scales meet",
+                m % 2 == 0 ? "concentric marks: two scales at one corner"
+                           : "fulcrums at the leaves' centres, one per leaf");
+}
+
+// (d) The rhombus of the chosen fulcrum over |DN(x) DN(y)|.
+void Sheet::rhombus_panel() {
+    const PixelRect a = panel_area(1, 1);
+    const double half = 1.12 * R + 2 * cell_size;
+    const Window w{chosen_q.x - half, chosen_q.x + half, chosen_q.y - half, chosen_q.y + half};
+    const PlotLayout L = square_layout(a, w);
+    const DualTable dn(m);
+    const double peak = dn.max_abs() * dn.max_abs();
+    const double scale = std::ldexp(1.0, cf.level);
+    const double eps = st.options.rhombus_radius > 0 ? dn.eps_for_rhombus_radius(st.rhombus_radius)
+                                                     : st.options.truncation_eps;
+    // The monotone envelope of |DN_m| about its fulcrum, on a 1/64 grid: env[q] = max |DN|
+    // over |u| >= q / 64 (u the distance from the fulcrum in cells). The rhombus radius is
+    // defined by this envelope (DualTable::rhombus_radius), so its contour E(x) E(y) = eps
+    // is what the rhombus has to contain.
+    const int n_env = static_cast<int>(64 * dn.half_width()) + 2;
+    std::vector<double> env(n_env + 1, 0.0);
+    for (int q = n_env - 1; q >= 0; --q)
+        env[q] = std::max({env[q + 1], std::fabs(dn(dn.fulcrum() + q / 64.0)),
+                           std::fabs(dn(dn.fulcrum() - q / 64.0))});
+    auto envelope = [&](double u) {
+        const int q = static_cast<int>(std::fabs(u) * 64);
+        return q < n_env ? env[q] : 0.0;
     };
+    // Per pixel: x = 2^L s - k, y = 2^L t - l, as in project().
+    std::vector<char> above(size_t(a.w) * a.h);
+    for (int py = 0; py < a.h; ++py)
+        for (int px = 0; px < a.w; ++px) {
+            const double sv = w.s0 + (px + 0.5) / a.w * (w.s1 - w.s0);
+            const double tv = w.t1 - (py + 0.5) / a.h * (w.t1 - w.t0);
+            const double v = std::fabs(dn(scale * sv - cf.k) * dn(scale * tv - cf.l)) / peak;
+            const double lg = v > 0 ? std::log10(v) : dn_log_floor;
+            image.at(a.x + px, a.y + py) = faint_map((lg - dn_log_floor) / -dn_log_floor);
+            above[size_t(py) * a.w + px] = envelope(scale * sv - cf.k - dn.fulcrum()) *
+                                               envelope(scale * tv - cf.l - dn.fulcrum()) >
+                                           eps * peak;
+        }
+    canvas.set_clip(a);
+    draw_leaves(canvas, L, forest, 0, 8, {0.78, 0.78, 0.78});
+    draw_patches(canvas, L, K, 0);
+    // The set where the envelope of |DN DN| exceeds eps: its boundary, two pixels wide.
+    for (int py = 1; py < a.h - 1; ++py)
+        for (int px = 1; px < a.w - 1; ++px) {
+            const size_t i = size_t(py) * a.w + px;
+            if (above[i] != above[i - 1] || above[i] != above[i + 1] ||
+                above[i] != above[i - a.w] || above[i] != above[i + a.w])
+                canvas.blend(a.x + px, a.y + py, {0.1, 0.1, 0.1});
+        }
+    const Vec2 top = L.to_pixel(chosen_q.x, chosen_q.y + R),
+               right = L.to_pixel(chosen_q.x + R, chosen_q.y),
+               bottom = L.to_pixel(chosen_q.x, chosen_q.y - R),
+               left = L.to_pixel(chosen_q.x - R, chosen_q.y);
+    canvas.polyline({top, right, bottom, left, top}, {rhombus_colour, 3});
+    draw_fulcrum(canvas, L.to_pixel(chosen_q.x, chosen_q.y), cf.level, style);
+    mark_chosen(canvas, L, chosen_q, chosen, s);
+    const Vec2 edge = 0.5 * (top + left);
+    const std::string r_label = "r = " + cell_g(st.rhombus_radius, 3) + " cells = " + cell_g(R, 3);
+    const int lw = text_width(r_label, s), lh = glyph_height * s;
+    const int lx = std::max(a.x + 4, int(edge.x) - 10 - lw);
+    canvas.fill_rect({lx - 3, int(edge.y) - 12 - lh, lw + 6, lh + 6}, {1, 1, 1});
+    canvas.text(lx, int(edge.y) - 9, r_label, rhombus_colour, s, Align::start, Align::end);
+    canvas.reset_clip();
+    draw_axes(image, L, "s", "t", ink, s);
+    panel_title(a, "(d) rhombus of fulcrum #" + std::to_string(chosen),
+                "|x| + |y| <= r, x = 2^" + std::to_string(cf.level) + " s - k; map: |DN(x) DN(y)|");
+}
 
-    const Vec2 chosen_q = st.fulcrums[chosen].position(m);
-    const Fulcrum& cf = st.fulcrums[chosen];
-    const double cell_size = std::ldexp(1.0, -cf.level);
-    const double R = st.rhombus_radius * cell_size;  // in parameter units
+// The legend's left column: levels, the leaves NeighAdjust made, the marks.
+void Sheet::level_legend() {
+    const int top = header_h + 2 * panel_h + 4;
+    const int line = glyph_line_height * s + 4;
+    const int x0 = pad, column_w = width / 2 - 2 * pad;
+    const int swatch_w = 36, text_x = x0 + swatch_w + 10;
+    int y = top;
+    canvas.text(x0, y, "colour = level L of a leaf or fulcrum (cell size 2^-L):", ink, s);
+    y += line + 4;
+    std::set<int> levels;
+    for (const auto& [l, n] : counts.domain_leaves) levels.insert(l);
+    for (const auto& [l, n] : counts.ring_leaves) levels.insert(l);
+    auto entry = [&](const std::string& text) {
+        for (const std::string& t : wrap_text(text, column_w - (text_x - x0), s)) {
+            canvas.text(text_x, y, t, ink, s);
+            y += glyph_line_height * s;
+        }
+        y += 10;
+    };
+    auto lookup = [](const std::map<int, int>& mp, int l) {
+        const auto it = mp.find(l);
+        return it == mp.end() ? 0 : it->second;
+    };
+    for (int l : levels) {
+        canvas.fill_rect({x0, y - 3, swatch_w, 20}, tint(level_colour(l), 0.30));
+        canvas.stroke_rect({x0, y - 3, swatch_w, 20}, leaf_line, 1);
+        if (counts.fulcrums.count(l)) draw_fulcrum(canvas, {x0 + 18.0, y + 7.0}, l, style);
+        entry("L" + std::to_string(l) + " (1/" + std::to_string(1 << l) +
+              "): " + std::to_string(lookup(counts.domain_leaves, l)) + " domain + " +
+              std::to_string(lookup(counts.ring_leaves, l)) + " ring leaves, " +
+              std::to_string(lookup(counts.fulcrums, l)) + " fulcrums");
+    }
+    // Hatch swatch for leaves that NeighAdjust made.
+    canvas.fill_rect({x0, y - 3, swatch_w, 20}, {1, 1, 1});
+    for (int d = -20; d < swatch_w; d += 6)
+        canvas.line(
+            {double(x0 + std::max(0, d)), double(y + 17 - std::max(0, -d))},
+            {double(x0 + std::min(swatch_w, d + 20)), double(y + 17 - std::min(20, swatch_w - d))},
+            {{0.3, 0.3, 0.3}, 1});
+    canvas.stroke_rect({x0, y - 3, swatch_w, 20}, leaf_line, 1);
+    entry(E.n_adjust_splits > 0
+              ? "hatched: leaves made by NeighAdjust (" + std::to_string(E.n_adjust_splits) +
+                    " splits after the oracle)"
+              : "hatched: leaves made by NeighAdjust; none here, the oracle's tree is "
+                "already graded by 2");
+    // Concentric marks.
+    if (m % 2 == 0) {
+        draw_fulcrum(canvas, {x0 + 18.0, y + 7.0}, coarsest, style);
+        draw_fulcrum(canvas, {x0 + 18.0, y + 7.0}, finest, style);
+    } else {
+        draw_fulcrum(canvas, {x0 + 6.0, y + 7.0}, finest, style);
+        draw_fulcrum(canvas, {x0 + 26.0, y + 7.0}, coarsest, style);
+    }
+    entry(m % 2 == 0 ? std::to_string(counts.coincident_pairs) +
+                           " corners carry fulcrums of two scales: a ring (coarser) "
+                           "around a dot (finer)"
+                     : "odd m: one fulcrum at each leaf's centre, so none coincide; a ring "
+                       "(coarser) or a dot (finest level)");
+    canvas.stroke_rect({x0 + 8, y - 3, 20, 20}, ink, 2);
+    entry("#" + std::to_string(chosen) +
+          ": the fulcrum of panel (d); dashed: the views of "
+          "panels (a) and (c)");
+    int n_beyond = 0;
+    for (const auto& [l, n] : counts.beyond_ring) n_beyond += n;
+    if (n_beyond > 0)
+        entry("note: the rhombi of " + std::to_string(n_beyond) +
+              " fulcrums reach past the ring and are cut at its edge");
+}
 
-    // (a) The domain and a strip of the ring around it.
+// The legend's right column: the map's colour scale, with eps marked.
+void Sheet::map_scale() {
+    const int top = header_h + 2 * panel_h + 4;
+    const int line = glyph_line_height * s + 4;
+    const int bx = width / 2 + pad, bw = width / 2 - 3 * pad;
+    const int by = top + line + 4;
+    const DualTable dn(m);
+    const double eps = st.options.rhombus_radius > 0 ? dn.eps_for_rhombus_radius(st.rhombus_radius)
+                                                     : st.options.truncation_eps;
+    draw_colour_scale(image, {bx, by, bw, 22}, std::pow(10.0, dn_log_floor), 1,
+                      "|DN(x) DN(y)| / max, panel (d)", faint_map, s, true);
+    const double te = (std::log10(eps) - dn_log_floor) / -dn_log_floor;
+    const int ex = bx + static_cast<int>(std::lround(te * (bw - 1)));
+    canvas.fill_rect({ex - 1, by - 4, 3, 30}, rhombus_colour);
+    canvas.text(ex, by + 22 + 3 * glyph_line_height * s / 2 + 6, "eps = " + cell_g(eps, 2),
+                rhombus_colour, s, Align::centre);
+    int ty = by + 22 + 3 * glyph_line_height * s + 8;
+    for (const std::string& t :
+         wrap_text("Red: the rhombus |x| + |y| <= r inside which the projection integrates. "
+                   "Dark line: where the decay envelope of |DN(x) DN(y)| falls to eps. DN decays "
+                   "by about the same factor per cell in x and in y, so the level lines of the "
+                   "product are diamonds. Light lattice: zeros of DN. Grey squares: leaves; "
+                   "black lines: domain and patches.",
+                   bw, s)) {
+        canvas.text(bx, ty, t, {0.3, 0.3, 0.3}, s);
+        ty += glyph_line_height * s;
+    }
+}
+
+Image compose(const Explained& E, const Counts& counts, int chosen) {
+    Sheet sheet(E, counts, chosen);
+    sheet.header();
     const Window view_a{-0.25, 1.25, -0.25, 1.25};
     const Window view_c = zoom_window(E);
-    {
-        const PixelRect a = panel_area(0, 0);
-        const PlotLayout L = square_layout(a, view_a);
-        canvas.set_clip(a);
-        draw_leaves(canvas, L, forest, 0.30, 4, leaf_line);
-        hatch_adjusted(canvas, L, E);
-        draw_patches(canvas, L, K, 3);
-        draw_fulcrums(canvas, L, st.fulcrums, m, style);
-        mark_chosen(canvas, L, chosen_q, chosen, s);
-        mark_window(canvas, L, view_c, "(c)", s);
-        canvas.reset_clip();
-        draw_axes(image, L, "s", "t", ink, s);
-        panel_title(a, "(a) quadtree and fulcrums",
-                    "domain + inner " + cell_g(-view_a.s0, 2) + " of the ring; colour: level");
-    }
-    // (b) The whole expanded domain.
-    {
-        const PixelRect a = panel_area(1, 0);
-        const Window w{-double(K), 1.0 + K, -double(K), 1.0 + K};
-        const PlotLayout L = square_layout(a, w);
-        canvas.set_clip(a);
-        draw_leaves(canvas, L, forest, 0.45, 5, {0.55, 0.55, 0.55});
-        draw_patches(canvas, L, K, 4);
-        mark_window(canvas, L, view_a, "(a)", s);
-        canvas.reset_clip();
-        draw_axes(image, L, "s", "t", ink, s);
-        panel_title(a, "(b) expanded domain: eight patches",
-                    "whole ring, " + std::to_string(K) + " units wide; numbered as in Figure 5");
-    }
-    // (c) Zoom where two sizes meet.
-    {
-        const PixelRect a = panel_area(0, 1);
-        const PlotLayout L = square_layout(a, view_c);
-        MarkerStyle big = style;
-        big.radius = 6;
-        big.step = 7;
-        canvas.set_clip(a);
-        draw_leaves(canvas, L, forest, 0.30, 4, leaf_line);
-        hatch_adjusted(canvas, L, E);
-        draw_patches(canvas, L, K, 3);
-        draw_fulcrums(canvas, L, st.fulcrums, m, big);
-        mark_chosen(canvas, L, chosen_q, chosen, s);
-        canvas.reset_clip();
-        draw_axes(image, L, "s", "t", ink, s);
-        panel_title(a, "(c) zoom: two scales meet",
-                    m % 2 == 0 ? "concentric marks: two scales at one corner"
-                               : "fulcrums at the leaves' centres, one per leaf");
-    }
-    // (d) The rhombus of the chosen fulcrum over |DN(x) DN(y)|.
-    {
-        const PixelRect a = panel_area(1, 1);
-        const double half = 1.12 * R + 2 * cell_size;
-        const Window w{chosen_q.x - half, chosen_q.x + half, chosen_q.y - half, chosen_q.y + half};
-        const PlotLayout L = square_layout(a, w);
-        const DualTable dn(m);
-        const double peak = dn.max_abs() * dn.max_abs();
-        const double scale = std::ldexp(1.0, cf.level);
-        const double eps = st.options.rhombus_radius > 0
-                               ? dn.eps_for_rhombus_radius(st.rhombus_radius)
-                               : st.options.truncation_eps;
-        // The monotone envelope of |DN_m| about its fulcrum, on a 1/64 grid: env[q] = max |DN|
-        // over |u| >= q / 64 (u the distance from the fulcrum in cells). The rhombus radius is
-        // defined by this envelope (DualTable::rhombus_radius), so its contour E(x) E(y) = eps
-        // is what the rhombus has to contain.
-        const int n_env = static_cast<int>(64 * dn.half_width()) + 2;
-        std::vector<double> env(n_env + 1, 0.0);
-        for (int q = n_env - 1; q >= 0; --q)
-            env[q] = std::max({env[q + 1], std::fabs(dn(dn.fulcrum() + q / 64.0)),
-                               std::fabs(dn(dn.fulcrum() - q / 64.0))});
-        auto envelope = [&](double u) {
-            const int q = static_cast<int>(std::fabs(u) * 64);
-            return q < n_env ? env[q] : 0.0;
-        };
-        // Per pixel: x = 2^L s - k, y = 2^L t - l, as in project().
-        std::vector<char> above(size_t(a.w) * a.h);
-        for (int py = 0; py < a.h; ++py)
-            for (int px = 0; px < a.w; ++px) {
-                const double sv = w.s0 + (px + 0.5) / a.w * (w.s1 - w.s0);
-                const double tv = w.t1 - (py + 0.5) / a.h * (w.t1 - w.t0);
-                const double v = std::fabs(dn(scale * sv - cf.k) * dn(scale * tv - cf.l)) / peak;
-                const double lg = v > 0 ? std::log10(v) : dn_log_floor;
-                image.at(a.x + px, a.y + py) = faint_map((lg - dn_log_floor) / -dn_log_floor);
-                above[size_t(py) * a.w + px] = envelope(scale * sv - cf.k - dn.fulcrum()) *
-                                                   envelope(scale * tv - cf.l - dn.fulcrum()) >
-                                               eps * peak;
-            }
-        canvas.set_clip(a);
-        draw_leaves(canvas, L, forest, 0, 8, {0.78, 0.78, 0.78});
-        draw_patches(canvas, L, K, 0);
-        // The set where the envelope of |DN DN| exceeds eps: its boundary, two pixels wide.
-        for (int py = 1; py < a.h - 1; ++py)
-            for (int px = 1; px < a.w - 1; ++px) {
-                const size_t i = size_t(py) * a.w + px;
-                if (above[i] != above[i - 1] || above[i] != above[i + 1] ||
-                    above[i] != above[i - a.w] || above[i] != above[i + a.w])
-                    canvas.blend(a.x + px, a.y + py, {0.1, 0.1, 0.1});
-            }
-        const Vec2 top = L.to_pixel(chosen_q.x, chosen_q.y + R),
-                   right = L.to_pixel(chosen_q.x + R, chosen_q.y),
-                   bottom = L.to_pixel(chosen_q.x, chosen_q.y - R),
-                   left = L.to_pixel(chosen_q.x - R, chosen_q.y);
-        canvas.polyline({top, right, bottom, left, top}, {rhombus_colour, 3});
-        draw_fulcrum(canvas, L.to_pixel(chosen_q.x, chosen_q.y), cf.level, style);
-        mark_chosen(canvas, L, chosen_q, chosen, s);
-        const Vec2 edge = 0.5 * (top + left);
-        const std::string r_label =
-            "r = " + cell_g(st.rhombus_radius, 3) + " cells = " + cell_g(R, 3);
-        const int lw = text_width(r_label, s), lh = glyph_height * s;
-        const int lx = std::max(a.x + 4, int(edge.x) - 10 - lw);
-        canvas.fill_rect({lx - 3, int(edge.y) - 12 - lh, lw + 6, lh + 6}, {1, 1, 1});
-        canvas.text(lx, int(edge.y) - 9, r_label, rhombus_colour, s, Align::start, Align::end);
-        canvas.reset_clip();
-        draw_axes(image, L, "s", "t", ink, s);
-        panel_title(
-            a, "(d) rhombus of fulcrum #" + std::to_string(chosen),
-            "|x| + |y| <= r, x = 2^" + std::to_string(cf.level) + " s - k; map: |DN(x) DN(y)|");
-    }
-
-    // Legend: levels, the map's colour scale, the summary.
-    {
-        const int top = header_h + 2 * panel_h + 4;
-        const int line = glyph_line_height * s + 4;
-        const int x0 = pad, column_w = width / 2 - 2 * pad;
-        const int swatch_w = 36, text_x = x0 + swatch_w + 10;
-        int y = top;
-        canvas.text(x0, y, "colour = level L of a leaf or fulcrum (cell size 2^-L):", ink, s);
-        y += line + 4;
-        std::set<int> levels;
-        for (const auto& [l, n] : counts.domain_leaves) levels.insert(l);
-        for (const auto& [l, n] : counts.ring_leaves) levels.insert(l);
-        auto entry = [&](const std::string& text) {
-            for (const std::string& t : wrap_text(text, column_w - (text_x - x0), s)) {
-                canvas.text(text_x, y, t, ink, s);
-                y += glyph_line_height * s;
-            }
-            y += 10;
-        };
-        auto lookup = [](const std::map<int, int>& mp, int l) {
-            const auto it = mp.find(l);
-            return it == mp.end() ? 0 : it->second;
-        };
-        for (int l : levels) {
-            canvas.fill_rect({x0, y - 3, swatch_w, 20}, tint(level_colour(l), 0.30));
-            canvas.stroke_rect({x0, y - 3, swatch_w, 20}, leaf_line, 1);
-            if (counts.fulcrums.count(l)) draw_fulcrum(canvas, {x0 + 18.0, y + 7.0}, l, style);
-            entry("L" + std::to_string(l) + " (1/" + std::to_string(1 << l) +
-                  "): " + std::to_string(lookup(counts.domain_leaves, l)) + " domain + " +
-                  std::to_string(lookup(counts.ring_leaves, l)) + " ring leaves, " +
-                  std::to_string(lookup(counts.fulcrums, l)) + " fulcrums");
-        }
-        // Hatch swatch for leaves that NeighAdjust made.
-        canvas.fill_rect({x0, y - 3, swatch_w, 20}, {1, 1, 1});
-        for (int d = -20; d < swatch_w; d += 6)
-            canvas.line({double(x0 + std::max(0, d)), double(y + 17 - std::max(0, -d))},
-                        {double(x0 + std::min(swatch_w, d + 20)),
-                         double(y + 17 - std::min(20, swatch_w - d))},
-                        {{0.3, 0.3, 0.3}, 1});
-        canvas.stroke_rect({x0, y - 3, swatch_w, 20}, leaf_line, 1);
-        entry(E.n_adjust_splits > 0
-                  ? "hatched: leaves made by NeighAdjust (" + std::to_string(E.n_adjust_splits) +
-                        " splits after the oracle)"
-                  : "hatched: leaves made by NeighAdjust; none here, the oracle's tree is "
-                    "already graded by 2");
-        // Concentric marks.
-        if (m % 2 == 0) {
-            draw_fulcrum(canvas, {x0 + 18.0, y + 7.0}, coarsest, style);
-            draw_fulcrum(canvas, {x0 + 18.0, y + 7.0}, finest, style);
-        } else {
-            draw_fulcrum(canvas, {x0 + 6.0, y + 7.0}, finest, style);
-            draw_fulcrum(canvas, {x0 + 26.0, y + 7.0}, coarsest, style);
-        }
-        entry(m % 2 == 0 ? std::to_string(counts.coincident_pairs) +
-                               " corners carry fulcrums of two scales: a ring (coarser) "
-                               "around a dot (finer)"
-                         : "odd m: one fulcrum at each leaf's centre, so none coincide; a ring "
-                           "(coarser) or a dot (finest level)");
-        canvas.stroke_rect({x0 + 8, y - 3, 20, 20}, ink, 2);
-        entry("#" + std::to_string(chosen) +
-              ": the fulcrum of panel (d); dashed: the views of "
-              "panels (a) and (c)");
-        int n_beyond = 0;
-        for (const auto& [l, n] : counts.beyond_ring) n_beyond += n;
-        if (n_beyond > 0)
-            entry("note: the rhombi of " + std::to_string(n_beyond) +
-                  " fulcrums reach past the ring and are cut at its edge");
-
-        // The map's colour scale, with eps marked.
-        const int bx = width / 2 + pad, bw = width / 2 - 3 * pad;
-        const int by = top + line + 4;
-        const DualTable dn(m);
-        const double eps = st.options.rhombus_radius > 0
-                               ? dn.eps_for_rhombus_radius(st.rhombus_radius)
-                               : st.options.truncation_eps;
-        draw_colour_scale(image, {bx, by, bw, 22}, std::pow(10.0, dn_log_floor), 1,
-                          "|DN(x) DN(y)| / max, panel (d)", faint_map, s, true);
-        const double te = (std::log10(eps) - dn_log_floor) / -dn_log_floor;
-        const int ex = bx + static_cast<int>(std::lround(te * (bw - 1)));
-        canvas.fill_rect({ex - 1, by - 4, 3, 30}, rhombus_colour);
-        canvas.text(ex, by + 22 + 3 * glyph_line_height * s / 2 + 6, "eps = " + cell_g(eps, 2),
-                    rhombus_colour, s, Align::centre);
-        int ty = by + 22 + 3 * glyph_line_height * s + 8;
-        for (const std::string& t : wrap_text(
-                 "Red: the rhombus |x| + |y| <= r inside which the projection integrates. "
-                 "Dark line: where the decay envelope of |DN(x) DN(y)| falls to eps. DN decays "
-                 "by about the same factor per cell in x and in y, so the level lines of the "
-                 "product are diamonds. Light lattice: zeros of DN. Grey squares: leaves; "
-                 "black lines: domain and patches.",
-                 bw, s)) {
-            canvas.text(bx, ty, t, {0.3, 0.3, 0.3}, s);
-            ty += glyph_line_height * s;
-        }
-    }
-    return image;
+    sheet.quadtree_panel(view_a, view_c);
+    sheet.expanded_panel(view_a);
+    sheet.zoom_panel(view_c);
+    sheet.rhombus_panel();
+    sheet.level_legend();  // legend: levels, the map's colour scale, the summary
+    sheet.map_scale();
+    return sheet.image;
 }
 
 std::string per_level(const std::map<int, int>& counts) {
