@@ -13,7 +13,7 @@
 #include "math/check.h"
 #include "math/parallel.h"
 #include "radiosity/solver/cost.h"
-#include "radiosity/transfer/receiver.h"
+#include "radiosity/transfer/transfer.h"
 #include "radiosity/scene/scene_io.h"
 #include "radiosity/solver/solver.h"
 

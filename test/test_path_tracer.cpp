@@ -8,7 +8,7 @@
 #include <cmath>
 #include <vector>
 
-#include "radiosity/transfer/sample_values.h"
+#include "radiosity/transfer/form_factor.h"
 #include "radiosity/reference/path_tracer.h"
 #include "radiosity/scene/scene_octree.h"
 

@@ -2,7 +2,7 @@
 // plane (paper section 5, "Upon the domain R[a,b;c,d] and each patch of the expanded domain,
 // there is a hierarchical structure"; Figure 5's eight patches) and NeighAdjust (section 5
 // "Adjustment of the Scale of Adjacent Subdomains", section 6 "Scale Adjustment", Figure 4;
-// radiosity/geometry/quadtree.h, adjust_neighbour_scales in radiosity/transfer/receiver.h).
+// radiosity/geometry/quadtree.h, adjust_neighbour_scales in radiosity/transfer/scale_adjustment.h).
 //
 // Independent references: brute force over all leaves (closed rectangles touching, half-open
 // containment), and a global fixed-point balancing loop that knows nothing of the twelve
@@ -16,7 +16,7 @@
 #include <vector>
 
 #include "radiosity/geometry/quadtree.h"
-#include "radiosity/transfer/receiver.h"
+#include "radiosity/transfer/transfer.h"
 #include "test/report.h"
 
 using namespace mbr;

@@ -525,20 +525,20 @@ TEST_CASE("scene_io: every statement of the format", "[scene_io]") {
     CHECK(o.oracle_tolerance == 1e-4);
     CHECK(o.truncation_eps == 1e-7);
     CHECK(o.rhombus_radius == 20);
-    CHECK(o.extrapolation == "higher");
+    CHECK(o.extrapolation == ExtrapolationSetting::Higher);
     CHECK(o.shadow_rays == 8);
     CHECK(o.max_shots == 10);
     CHECK(o.convergence == 0.01);
     CHECK(o.self_transfer);
     CHECK(o.tessellation == 8);
-    CHECK(o.contact_oracle == "interpolation");
+    CHECK(o.contact_oracle == ContactOracleSetting::Interpolation);
     CHECK(solver_options(o).receiver.contact_oracle_test == OracleTest::Interpolation);
     // Defaults when nothing is set.
     Scene d = parse_text(white + square);
     CHECK(d.settings.order == 4);
-    CHECK(d.settings.contact_oracle == "means");
+    CHECK(d.settings.contact_oracle == ContactOracleSetting::Means);
     CHECK(solver_options(d.settings).receiver.contact_oracle_test == OracleTest::Means);
-    CHECK(d.settings.extrapolation == "linear");
+    CHECK(d.settings.extrapolation == ExtrapolationSetting::Linear);
     CHECK(!d.has_camera);
 }
 

@@ -2,7 +2,7 @@
 // radiosity/solver/solver.h) and its solution files (docs/solution-format.md).
 //
 // Independent references: the power balance of a closed box (everything a shooter sends arrives
-// on some face), the single transfer of radiosity/transfer/receiver.h run by hand with the options the
+// on some face), the single transfer of radiosity/transfer/transfer.h run by hand with the options the
 // loop gives it, and the analytic point-to-polygon form factor for a first bounce. The scenes
 // are small and the depths low, so that every test runs in about a second.
 #include <catch2/catch.hpp>
@@ -14,7 +14,7 @@
 #include "math/check.h"
 #include "radiosity/visibility/hidden_regions.h"
 #include "radiosity/transfer/sample_values.h"
-#include "radiosity/transfer/receiver.h"
+#include "radiosity/transfer/transfer.h"
 #include "radiosity/scene/scene_io.h"
 #include "radiosity/scene/scene_octree.h"
 #include "radiosity/visibility/visible_parts.h"

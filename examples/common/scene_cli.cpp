@@ -24,145 +24,79 @@
 
 namespace mbr {
 
-const char* solver_options_usage =
-    "  SCENE                     a scene file (docs/scene-format.md)\n"
-    "  --order m                 B-spline order, 2..8 (scene's `set order`, default 4)\n"
-    "  --min-depth d --max-depth d   receiver quadtree bounds, 0..12\n"
-    "  --shots n                 at most n shots, 0..10000000 (scene's max_shots, default 100)\n"
-    "  --convergence c           stop when the largest unshot power is below c x emitted, [0, 1)\n"
-    "  --tolerance x             accuracy relative to the scene's radiosity scale, (0, 1)\n"
-    "                            (scene's `set tolerance`, default 2e-3): sets every\n"
-    "                            transfer's absolute tolerance\n"
-    "  --shadows M               exact (visibility inside (21), default), paper\n"
-    "                            (fractions (28) and masking) or none (`set shadows`)\n"
-    "  --rays R                  paper shadows: rays per shooter patch, 1..4096\n"
-    "  --shooter-level L         a shooter's unshot field is coarsened to at most level L,\n"
-    "                            0..12 (scene's `set shooter_level`, default 3)\n"
-    "  --contact-depth D         receiver cells touching a planar shooter split to at least\n"
-    "                            level D, 0..12 (scene's `set contact_depth`, default 2)\n"
-    "  --contact-oracle T        the oracle's test in cells touching a planar shooter:\n"
-    "                            means (the paper's, default) or interpolation\n"
-    "                            (`set contact_oracle`)\n"
-    "  --unify projection|paper  every finest coefficient projected on the fine grid\n"
-    "                            (default), or the paper's (17) from selected fulcrums\n"
-    "                            (`set unify`)\n"
-    "  --ambient on|off          the ambient correction of the unshot power (`set ambient`,\n"
-    "                            default on)\n"
-    "  --hidden on|off           hidden regions take their visible neighbours' values\n"
-    "                            (`set hidden`, default on)\n"
-    "  --threads n               OpenMP threads, 1..256 (default: all cores)\n"
-    "  --quiet                   no progress bar\n"
-    "  --memory-budget X         refuse a run estimated to need more memory (bytes, or K, M,\n"
-    "                            G, T: 4G; default half the physical memory)\n";
+std::string solver_options_usage() {
+    return "  SCENE                     a scene file (docs/scene-format.md)\n" + option_usage() +
+           "  --threads n               OpenMP threads, 1..256 (default: all cores)\n"
+           "  --quiet                   no progress bar\n"
+           "  --memory-budget X         refuse a run estimated to need more memory (bytes, or K, M,\n"
+           "                            G, T: 4G; default half the physical memory)\n";
+}
 
 namespace {
 
-/// The solver options of the command line, read before the scene is known.
+/// One option of the table set from the command line; a bad value is a usage error naming the
+/// flag as written.
+void apply_flag(SolverSettings& s, const OptionSpec* option, const std::string& flag,
+                const std::string& value) {
+    try {
+        apply_setting(s, *option, value, flag);
+    } catch (const InputError& e) {
+        throw UsageError(e.message());
+    }
+}
+
+/// The solver options of the command line, read before the scene is known: each option of the
+/// table (radiosity/scene/settings.h) the line gives, with the spelling it was given as.
 struct SolverArgs {
-    int order = -1, min_depth = -1, max_depth = -1, shots = -1, rays = -1, shooter_level = -1,
-        contact_depth = -1;
-    double convergence = -1, tolerance = -1;
+    struct Given {
+        const OptionSpec* option = nullptr;
+        std::string flag;  // as written: the flag or an alias
+        std::string value;
+    };
+    std::vector<Given> given;
     double memory_budget = 0;
-    std::string shadows, unify, ambient, hidden, contact_oracle;
-    // Which options the command line gave: only those override the scene's `set` lines.
-    bool has_min_depth = false, has_max_depth = false, has_tolerance = false,
-         has_shadows = false, has_unify = false, has_ambient = false, has_hidden = false,
-         has_contact_oracle = false;
+    /// True when the line gives the option called `name`.
+    bool has(const std::string& name) const {
+        for (const Given& g : given)
+            if (g.option->name == name) return true;
+        return false;
+    }
 };
 
 SolverArgs read_solver_args(Args& args, SceneRun& run) {
-    auto in_range = [](const std::string& name, double v, double lo, double hi,
-                       bool open_lo = false, bool open_hi = false) {
-        const bool ok = (open_lo ? v > lo : v >= lo) && (open_hi ? v < hi : v <= hi);
-        if (!ok) {
-            std::ostringstream os;
-            os << name << " must be in " << (open_lo ? "(" : "[") << lo << ", " << hi
-               << (open_hi ? ")" : "]") << ", got " << v;
-            throw UsageError(os.str());
-        }
-    };
     SolverArgs a;
-    a.order = args.integer("--order", -1);
-    a.min_depth = args.integer("--min-depth", -1);
-    a.max_depth = args.integer("--max-depth", -1);
-    a.shots = args.integer("--shots", -1);
-    a.convergence = args.number("--convergence", -1);
-    a.tolerance = args.number("--tolerance", -1);
-    a.shadows = args.text("--shadows", "exact");
-    a.rays = args.integer("--rays", -1);
-    a.shooter_level = args.integer("--shooter-level", -1);
-    a.contact_depth = args.integer("--contact-depth", -1);
-    a.unify = args.text("--unify", "projection");
-    a.contact_oracle = args.text("--contact-oracle", "means");
-    a.ambient = args.text("--ambient", "on");
-    a.hidden = args.text("--hidden", "on");
-    run.threads = args.integer("--threads", 0);
+    for (const OptionSpec& o : option_table()) {
+        std::vector<std::string> spellings{o.flag()};
+        spellings.insert(spellings.end(), o.aliases.begin(), o.aliases.end());
+        for (const std::string& flag : spellings)
+            if (args.has(flag)) a.given.push_back({&o, flag, args.text(flag, "")});
+    }
+    // The values are checked here, before the scene is read, so that a bad flag is a usage
+    // error whatever the scene holds.
+    SolverSettings check;
+    for (const SolverArgs::Given& g : a.given) apply_flag(check, g.option, g.flag, g.value);
+    run.threads = args.integer("--threads", 0, 1, 256);
     run.quiet = args.flag("--quiet");
     a.memory_budget = read_memory_budget(args);
-    a.has_min_depth = args.has("--min-depth");
-    a.has_max_depth = args.has("--max-depth");
-    a.has_tolerance = args.has("--tolerance");
-    a.has_shadows = args.has("--shadows");
-    a.has_unify = args.has("--unify");
-    a.has_ambient = args.has("--ambient");
-    a.has_hidden = args.has("--hidden");
-    a.has_contact_oracle = args.has("--contact-oracle");
-
-    if (args.has("--order")) in_range("--order", a.order, 2, 8);
-    if (a.has_min_depth) in_range("--min-depth", a.min_depth, 0, 12);
-    if (a.has_max_depth) in_range("--max-depth", a.max_depth, 0, 12);
-    if (args.has("--shots")) in_range("--shots", a.shots, 0, 1e7);
-    if (args.has("--convergence")) in_range("--convergence", a.convergence, 0, 1, false, true);
-    if (a.has_tolerance) in_range("--tolerance", a.tolerance, 0, 1, true, true);
-    if (args.has("--rays")) in_range("--rays", a.rays, 1, 4096);
-    if (args.has("--shooter-level")) in_range("--shooter-level", a.shooter_level, 0, 12);
-    if (args.has("--contact-depth")) in_range("--contact-depth", a.contact_depth, 0, 12);
-    if (args.has("--threads")) in_range("--threads", run.threads, 1, 256);
-    if (a.shadows != "exact" && a.shadows != "paper" && a.shadows != "none")
-        throw UsageError("--shadows must be exact, paper or none");
-    if (a.unify != "projection" && a.unify != "paper")
-        throw UsageError("--unify must be projection or paper");
-    if (a.contact_oracle != "interpolation" && a.contact_oracle != "means")
-        throw UsageError("--contact-oracle must be interpolation or means");
-    for (const auto& [name, value] :
-         {std::pair{"--ambient", a.ambient}, std::pair{"--hidden", a.hidden}})
-        if (value != "on" && value != "off")
-            throw UsageError(std::string(name) + " must be on or off");
     return a;
 }
 
 /// The scene's settings, then the command line over them; threads; the octree.
 void finish_scene_run(const SolverArgs& a, SceneRun& run) {
-    SolverOptions& o = run.options;
-    o = solver_options(run.scene.settings);
-    if (a.order > 0) o.receiver.m = a.order;
-    if (a.min_depth >= 0) o.receiver.min_depth = a.min_depth;
-    if (a.max_depth >= 0) o.receiver.max_depth = a.max_depth;
-    if (o.receiver.min_depth > o.receiver.max_depth) {
-        if (a.has_min_depth && a.has_max_depth)
-            throw UsageError("--min-depth must not exceed --max-depth");
+    SolverSettings s = run.scene.settings;
+    for (const SolverArgs::Given& g : a.given) apply_flag(s, g.option, g.flag, g.value);
+    if (s.min_depth > s.max_depth) {
+        const bool has_min = a.has("min_depth"), has_max = a.has("max_depth");
+        if (has_min && has_max) throw UsageError("--min-depth must not exceed --max-depth");
         // One bound given on the command line moves the other along.
-        if (a.has_max_depth)
-            o.receiver.min_depth = o.receiver.max_depth;
+        if (has_max)
+            s.min_depth = s.max_depth;
         else
-            o.receiver.max_depth = o.receiver.min_depth;
+            s.max_depth = s.min_depth;
     }
-    if (a.shots >= 0) o.max_shots = a.shots;
-    if (a.convergence >= 0) o.convergence = a.convergence;
-    if (a.has_tolerance) o.tolerance = a.tolerance;
-    if (a.has_shadows)
-        o.receiver.shadows.method = a.shadows == "exact"   ? ShadowMethod::Exact
-                                    : a.shadows == "paper" ? ShadowMethod::Fractions
-                                                           : ShadowMethod::None;
-    if (a.rays > 0) o.receiver.shadows.rays_per_patch = a.rays;
-    if (a.shooter_level >= 0) o.shooter_level = a.shooter_level;
-    if (a.contact_depth >= 0) o.receiver.contact_depth = a.contact_depth;
-    if (a.has_contact_oracle)
-        o.receiver.contact_oracle_test = a.contact_oracle == "means" ? OracleTest::Means
-                                                                     : OracleTest::Interpolation;
-    if (a.has_ambient) o.ambient = a.ambient == "on";
-    if (a.has_unify) o.receiver.unify_by_projection = a.unify == "projection";
-    if (a.has_hidden) o.hidden_regions = a.hidden == "on";
+    run.scene.settings = s;
+    SolverOptions& o = run.options;
+    o = solver_options(s);
 #ifdef _OPENMP
     if (run.threads > 0) omp_set_num_threads(run.threads);
 #endif

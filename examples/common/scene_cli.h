@@ -16,8 +16,9 @@
 
 namespace mbr {
 
-/// Usage lines of the options read_scene_run understands.
-extern const char* solver_options_usage;
+/// Usage lines of the options read_scene_run understands: SCENE, every option of the table
+/// (radiosity/scene/settings.h), --threads, --quiet and --memory-budget.
+std::string solver_options_usage();
 
 /// A scene to solve, with its options and octree.
 struct SceneRun {
@@ -29,12 +30,13 @@ struct SceneRun {
     std::unique_ptr<Octree> octree;  // over scene_polygons(scene, settings.tessellation)
 };
 
-/// Reads the solver options (--order, --min-depth, --max-depth, --shots, --tolerance,
-/// --convergence, --shadows, --rays, --threads, --quiet, ...), then the scene path (the one
-/// positional argument, or `default_scene` when empty and none is given), loads the scene and
-/// builds its octree. Call it after reading the program's own options.
+/// Reads the solver options (every flag of the option table, radiosity/scene/settings.h, with
+/// its aliases such as --shots and --rays; --threads, --quiet, --memory-budget), then the scene
+/// path (the one positional argument, or `default_scene` when empty and none is given), loads
+/// the scene and builds its octree. The flags override the scene's `set` lines (and are written
+/// into run.scene.settings). Call it after reading the program's own options.
 SceneRun read_scene_run(Args& args, const std::string& default_scene);
-/// The same for a scene made by the program: the options of solver_options_usage without SCENE
+/// The same for a scene made by the program: the options of solver_options_usage() without SCENE
 /// (a positional argument is refused), applied over the scene's settings; `name` stands for the
 /// path in summaries.
 SceneRun read_scene_run(Args& args, Scene scene, const std::string& name);

@@ -62,7 +62,7 @@ std::string render_usage() {
                "  --save-solution F         write the solved fields to F\n"
                "  --load-solution F         render F's fields instead of solving\n"
                "  --seed n                  seed of the pixel jitter (default 1)\n") +
-           solver_options_usage;
+           solver_options_usage();
 }
 
 std::string probe_usage() {
@@ -76,7 +76,7 @@ std::string probe_usage() {
                "                            Each point goes to the nearest surface point within\n"
                "                            1e-3 of the scene's bounding-box diagonal.\n"
                "  --load-solution F         use F's fields instead of solving\n") +
-           solver_options_usage;
+           solver_options_usage();
 }
 
 /// A solution: solved now (printing the summary unless quiet), or loaded.

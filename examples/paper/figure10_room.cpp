@@ -42,7 +42,7 @@ std::string usage() {
                "coefficients\n"
                "  -o FILE.png               a picture of the solution (the scene's camera)\n"
                "  --spp n                   samples per pixel of the picture, 1..4096 (4)\n") +
-           solver_options_usage;
+           solver_options_usage();
 }
 
 /// One shot's line, printed as soon as it is done (a room's shot can take minutes).

@@ -33,7 +33,7 @@
 
 #include "examples/common/cli.h"
 #include "examples/common/scene_cli.h"
-#include "radiosity/transfer/sample_values.h"
+#include "radiosity/transfer/form_factor.h"
 #include "radiosity/output/output_file.h"
 
 namespace mbr {
@@ -52,7 +52,7 @@ std::string usage() {
                "  --points n                points along each shared edge, 2..100000 (1024)\n"
                "  -o FILE.png               a picture of one of the two solutions\n"
                "  --image linear|higher     which one (default linear)\n") +
-           solver_options_usage;
+           solver_options_usage();
 }
 
 /// The three strips and the light, by name in the scene.

@@ -65,7 +65,7 @@ std::string usage() {
                "                            clamp_values, default on)\n"
                "  Solver options (SCENE is not taken; defaults: convergence 1e-6, shots 2000,\n"
                "  tolerance 5e-4, contact oracle interpolation):\n") +
-           solver_options_usage;
+           solver_options_usage();
 }
 
 constexpr double rho = 0.5;  // reflectance of every face

@@ -52,7 +52,7 @@ std::string usage() {
                "  --csv                     header setting,seconds,mean_err_percent,"
                "max_err_percent,shots,coefficients\n"
                "  -o DIR                    renders and error maps per setting\n") +
-           solver_options_usage;
+           solver_options_usage();
 }
 
 /// One rung of the ladder: what it changes from the command line's options.

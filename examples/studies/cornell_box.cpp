@@ -25,7 +25,7 @@ std::string usage() {
                "  --csv                     header shots,unshot_percent,seconds,peak_mib,"
                "coefficients\n"
                "  -o FILE.png               a picture of the solution\n") +
-           solver_options_usage;
+           solver_options_usage();
 }
 
 int run(Args& args) {

@@ -361,7 +361,7 @@ Row measure(const fs::path& dir, int n_quads, int n_rays, int seed, const SolveS
 
     if (solve.shots > 0 && n_quads <= solve.max_quads) {
         mbr::SolverSettings settings = scene.settings;
-        settings.shadows = solve.shadows;
+        mbr::apply_setting(settings, *mbr::find_option("shadows"), solve.shadows, "--solve-shadows");
         mbr::SolverOptions options = mbr::solver_options(settings);
         options.max_shots = solve.shots;
         options.convergence = 0;  // never stop early: the same number of shots at every size

@@ -8,7 +8,7 @@
 
 #include "math/check.h"
 #include "math/parallel.h"
-#include "radiosity/transfer/sample_values.h"
+#include "radiosity/transfer/form_factor.h"
 
 namespace mbr {
 

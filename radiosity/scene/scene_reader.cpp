@@ -14,6 +14,7 @@
 #include "radiosity/scene/faces_to_quads.h"
 #include "radiosity/scene/line_reader.h"
 #include "radiosity/scene/obj_reader.h"
+#include "radiosity/scene/settings.h"
 
 namespace mbr {
 
@@ -502,78 +503,17 @@ private:
         const std::string& value = line[2];
         if (!settings_seen_.insert(key).second)
             line.fail("setting " + in_quotes(key) + " is given twice");
-        SolverSettings& s = scene_.settings;
-        auto integer = [&](long long lo, long long hi) {
-            return int(parse_integer(line, value, key, lo, hi));
-        };
-        auto real = [&](double lo, double hi, bool open_lo, bool open_hi) {
-            double x = parse_double(line, value, key);
-            if (x < lo || x > hi || (open_lo && x == lo) || (open_hi && x == hi))
-                line.fail(key + " " + fmt(x) + " is outside " + (open_lo ? "(" : "[") + fmt(lo) +
-                          ", " + fmt(hi) + (open_hi ? ")" : "]"));
-            return x;
-        };
-        if (key == "order") {
-            s.order = integer(2, 8);
-        } else if (key == "min_depth") {
-            s.min_depth = integer(0, 12);
-            depth_line_ = line;
-        } else if (key == "max_depth") {
-            s.max_depth = integer(0, 12);
-            depth_line_ = line;
-        } else if (key == "oracle_tolerance") {
-            s.oracle_tolerance = real(0, 1, true, false);
-        } else if (key == "truncation_eps") {
-            s.truncation_eps = real(0, 1, true, true);
-        } else if (key == "rhombus_radius") {
-            s.rhombus_radius = real(0, 1000, false, false);
-        } else if (key == "extrapolation") {
-            if (value != "linear" && value != "higher")
-                line.fail("extrapolation " + in_quotes(value) +
-                          " is neither 'linear' nor 'higher'");
-            s.extrapolation = value;
-        } else if (key == "shadow_rays") {
-            s.shadow_rays = integer(1, 4096);
-        } else if (key == "max_shots") {
-            s.max_shots = integer(0, 10000000);
-        } else if (key == "convergence") {
-            s.convergence = real(0, 1, false, true);
-        } else if (key == "self_transfer") {
-            if (value != "true" && value != "false")
-                line.fail("self_transfer " + in_quotes(value) + " is neither 'true' nor 'false'");
-            s.self_transfer = value == "true";
-        } else if (key == "tessellation") {
-            s.tessellation = integer(1, 1024);
-        } else if (key == "shadows") {
-            if (value != "exact" && value != "paper" && value != "none")
-                line.fail("shadows " + in_quotes(value) + " is not 'exact', 'paper' or 'none'");
-            s.shadows = value;
-        } else if (key == "tolerance") {
-            s.tolerance = real(0, 1, true, true);
-        } else if (key == "unify") {
-            if (value != "projection" && value != "paper")
-                line.fail("unify " + in_quotes(value) + " is neither 'projection' nor 'paper'");
-            s.unify = value;
-        } else if (key == "shooter_level") {
-            s.shooter_level = integer(0, 12);
-        } else if (key == "contact_depth") {
-            s.contact_depth = integer(0, 12);
-        } else if (key == "contact_oracle") {
-            if (value != "interpolation" && value != "means")
-                line.fail("contact_oracle " + in_quotes(value) +
-                          " is neither 'interpolation' nor 'means'");
-            s.contact_oracle = value;
-        } else if (key == "ambient" || key == "hidden") {
-            if (value != "true" && value != "false")
-                line.fail(key + " " + in_quotes(value) + " is neither 'true' nor 'false'");
-            (key == "ambient" ? s.ambient : s.hidden) = value == "true";
-        } else {
-            line.fail("unknown setting " + in_quotes(key) +
-                      " (known: order, min_depth, max_depth, oracle_tolerance, truncation_eps, "
-                      "rhombus_radius, extrapolation, shadow_rays, max_shots, convergence, "
-                      "self_transfer, tessellation, shadows, tolerance, unify, ambient, hidden, "
-                      "shooter_level, contact_depth, contact_oracle)");
+        // The option table (radiosity/scene/settings.h) knows every setting, its range and
+        // its messages.
+        const OptionSpec* option = find_option(key);
+        if (!option) {
+            std::string known;
+            for (const OptionSpec& o : option_table())
+                known += (known.empty() ? "" : ", ") + o.name;
+            line.fail("unknown setting " + in_quotes(key) + " (known: " + known + ")");
         }
+        apply_setting(scene_.settings, *option, value, key, line.file, line.number);
+        if (key == "min_depth" || key == "max_depth") depth_line_ = line;
     }
 
     // --- obj FILE, include FILE

@@ -6,7 +6,7 @@
 
 #include <string>
 
-#include "radiosity/transfer/receiver.h"
+#include "radiosity/transfer/transfer.h"
 #include "radiosity/scene/scene.h"
 #include "radiosity/solver/solver.h"
 

@@ -14,7 +14,7 @@
 #include "math/check.h"
 #include "math/gauss_legendre.h"
 #include "math/parallel.h"
-#include "radiosity/visibility/visible_parts.h"
+#include "radiosity/visibility/occlusion.h"
 
 namespace mbr {
 
@@ -125,7 +125,7 @@ SolverOptions solver_options(const SolverSettings& s) {
     o.receiver.quadrature.n = 4;
     // DESIGN: every finest-level coefficient projected on the fine grid (project_fine_grid):
     // adaptive trees then reach the accuracy of uniform ones (docs/method.md, adaptive study).
-    o.receiver.unify_by_projection = s.unify == "projection";
+    o.receiver.unify_by_projection = s.unify == UnifySetting::Projection;
     // DESIGN: cost follows energy (measured on the Cornell box, docs/method.md): a receiver
     // that gets less than 10 absolute tolerances starts its oracle at the root, the shadowed
     // part's triangles use 3 against 4 points, edgefill stops 2 levels below the finest
@@ -139,8 +139,9 @@ SolverOptions solver_options(const SolverSettings& s) {
     // (`set contact_oracle interpolation`): what the uniform cube's corners need; on the
     // Cornell box it gains less than it costs (ReceiverOptions::contact_oracle_test,
     // docs/method.md).
-    o.receiver.contact_oracle_test =
-        s.contact_oracle == "interpolation" ? OracleTest::Interpolation : OracleTest::Means;
+    o.receiver.contact_oracle_test = s.contact_oracle == ContactOracleSetting::Interpolation
+                                         ? OracleTest::Interpolation
+                                         : OracleTest::Means;
     o.receiver.quadrature.n_pieces = 3;
     o.receiver.edgefill_max_depth = 2;
     o.receiver.m = s.order;
@@ -149,12 +150,13 @@ SolverOptions solver_options(const SolverSettings& s) {
     o.receiver.oracle_tolerance = s.oracle_tolerance;
     o.receiver.truncation_eps = s.truncation_eps;
     o.receiver.rhombus_radius = s.rhombus_radius;
-    o.receiver.extrapolation =
-        s.extrapolation == "linear" ? Extrapolation::Linear : Extrapolation::Quadratic;
+    o.receiver.extrapolation = s.extrapolation == ExtrapolationSetting::Linear
+                                   ? Extrapolation::Linear
+                                   : Extrapolation::Quadratic;
     o.receiver.shadows.rays_per_patch = s.shadow_rays;
-    o.receiver.shadows.method = s.shadows == "exact"   ? ShadowMethod::Exact
-                                : s.shadows == "paper" ? ShadowMethod::Fractions
-                                                       : ShadowMethod::None;
+    o.receiver.shadows.method = s.shadows == ShadowSetting::Exact   ? ShadowMethod::Exact
+                                : s.shadows == ShadowSetting::Paper ? ShadowMethod::Fractions
+                                                                    : ShadowMethod::None;
     o.max_shots = s.max_shots;
     o.convergence = s.convergence;
     o.self_transfer = s.self_transfer;
@@ -327,26 +329,10 @@ bool ProgressiveSolver::done() const {
     return largest <= options_.convergence * st.emitted_power;
 }
 
-ShotStats ProgressiveSolver::shoot() {
-    const double start = now();
-    const int n = static_cast<int>(scene_.surfaces.size());
-    ShotStats shot;
-    shot.shot = solution_.stats.shots + 1;
-    // "pick out the surface A_jm which has the largest value of int int_Aj dB" (sum of the
-    // channels' unshot power; ties to the lowest index).
-    std::vector<double> unshot(n);
-    for (int i = 0; i < n; ++i) {
-        unshot[i] = unshot_power(i);
-        shot.unshot_before += unshot[i];
-        if (shot.shooter < 0 || unshot[i] > unshot[shot.shooter]) shot.shooter = i;
-    }
-    const int h = shot.shooter;
-    shot.shooter_power = unshot[h];
+std::vector<int> ProgressiveSolver::receivers_of(int h) const {
     const Surface& shooter_surface = scene_.surfaces[h].surface;
-
-    // The receivers: every surface that can see the shooter's front and be seen by it.
     std::vector<int> receivers;
-    for (int i = 0; i < n; ++i) {
+    for (int i = 0; i < int(scene_.surfaces.size()); ++i) {
         const Surface& r = scene_.surfaces[i].surface;
         if (i == h) {
             if (options_.self_transfer && r.is_concave()) receivers.push_back(i);
@@ -357,25 +343,15 @@ ShotStats ProgressiveSolver::shoot() {
         if (behind(shooter_surface, r) || behind(r, shooter_surface)) continue;
         receivers.push_back(i);
     }
-    shot.receivers = static_cast<int>(receivers.size());
+    return receivers;
+}
 
-    // Tolerances against the scene's scale (cost follows energy).
-    ReceiverOptions ro = options_.receiver;
-    ro.absolute_tolerance = options_.tolerance * radiosity_scale_;
-    ro.quadrature.abs_tolerance = options_.quadrature_share * ro.absolute_tolerance;
-    const SplineField& unshot_h = solution_.unshot[h];
-    const int coarsen = std::max(ro.shooter_coarsening, unshot_h.level() - options_.shooter_level);
-    const Shooter shooter = make_shooter(shooter_surface, unshot_h, coarsen);
-
-    struct Received {
-        SplineField field;
-        TransferStats stats;
-        std::vector<std::uint64_t> splits;
-    };
-    std::vector<Received> results(receivers.size());
-    // The big transfers first would balance better, but each receiver's result must not depend
-    // on the schedule: it does not (each transfer is independent), only the time does.
+std::vector<ProgressiveSolver::Received> ProgressiveSolver::transfer_to(
+    const std::vector<int>& receivers, int h, const Shooter& shooter, const ReceiverOptions& ro,
+    int shot_number) {
+    const Surface& shooter_surface = scene_.surfaces[h].surface;
     const int n_rec = static_cast<int>(receivers.size());
+    std::vector<Received> results(receivers.size());
     auto run_one = [&](int k) {
         const int i = receivers[k];
         const Texture& rho = scene_.material_of(i).reflectance;
@@ -383,7 +359,7 @@ ShotStats ProgressiveSolver::shoot() {
                                        [&rho](double s, double t) { return rho.value(s, t); },
                                        hidden_[i].any() ? &hidden_[i] : nullptr};
         const OcclusionContext occlusion = make_occlusion_context(
-            octree_, shooter_surface, h, scene_.surfaces[i].surface, i, std::uint64_t(shot.shot));
+            octree_, shooter_surface, h, scene_.surfaces[i].surface, i, std::uint64_t(shot_number));
         ReceiverState state;
         results[k].field =
             transfer(shooter, receiver, ro, &results[k].stats, &state, &occlusion, &dual_);
@@ -407,8 +383,14 @@ ShotStats ProgressiveSolver::shoot() {
         parallel_for(n_rec, [&](int k) { run_one(order[k]); });
     }
     for (int k = 0; k < n_rec; ++k) last_seconds_[receivers[k]] = results[k].stats.seconds_total;
+    return results;
+}
 
-    // Superposition in receiver order: B_i += dB_i, B_unshot_i += dB_i; then B_unshot_h = 0.
+void ProgressiveSolver::superpose(const std::vector<int>& receivers,
+                                  std::vector<Received>& results, int h, const Shooter& shooter,
+                                  ShotStats& shot) {
+    const int n = static_cast<int>(scene_.surfaces.size());
+    const int n_rec = static_cast<int>(receivers.size());
     const Rgb shot_power = power(h, shooter.unshot);
     std::vector<Rgb>& row = coupling_[h];
     if (row.empty()) row.assign(n, Rgb{});
@@ -436,6 +418,7 @@ ShotStats ProgressiveSolver::shoot() {
         std::sort(cells.begin(), cells.end());
         cells.erase(std::unique(cells.begin(), cells.end()), cells.end());
     }
+    const Surface& shooter_surface = scene_.surfaces[h].surface;
     if (!(options_.self_transfer && shooter_surface.is_concave() &&
           std::find(receivers.begin(), receivers.end(), h) != receivers.end())) {
         solution_.unshot[h] = SplineField::constant(options_.receiver.m, 0, {0, 0, 0});
@@ -444,6 +427,38 @@ ShotStats ProgressiveSolver::shoot() {
         for (int k = 0; k < n_rec; ++k)
             if (receivers[k] == h) solution_.unshot[h] = results[k].field;
     }
+}
+
+ShotStats ProgressiveSolver::shoot() {
+    const double start = now();
+    const int n = static_cast<int>(scene_.surfaces.size());
+    ShotStats shot;
+    shot.shot = solution_.stats.shots + 1;
+    // "pick out the surface A_jm which has the largest value of int int_Aj dB" (sum of the
+    // channels' unshot power; ties to the lowest index).
+    std::vector<double> unshot(n);
+    for (int i = 0; i < n; ++i) {
+        unshot[i] = unshot_power(i);
+        shot.unshot_before += unshot[i];
+        if (shot.shooter < 0 || unshot[i] > unshot[shot.shooter]) shot.shooter = i;
+    }
+    const int h = shot.shooter;
+    shot.shooter_power = unshot[h];
+
+    // The receivers: every surface that can see the shooter's front and be seen by it.
+    const std::vector<int> receivers = receivers_of(h);
+    shot.receivers = static_cast<int>(receivers.size());
+
+    // Tolerances against the scene's scale (cost follows energy).
+    ReceiverOptions ro = options_.receiver;
+    ro.absolute_tolerance = options_.tolerance * radiosity_scale_;
+    ro.quadrature.abs_tolerance = options_.quadrature_share * ro.absolute_tolerance;
+    const SplineField& unshot_h = solution_.unshot[h];
+    const int coarsen = std::max(ro.shooter_coarsening, unshot_h.level() - options_.shooter_level);
+    const Shooter shooter = make_shooter(scene_.surfaces[h].surface, unshot_h, coarsen);
+
+    std::vector<Received> results = transfer_to(receivers, h, shooter, ro, shot.shot);
+    superpose(receivers, results, h, shooter, shot);
     for (int i = 0; i < n; ++i) shot.unshot_after += unshot_power(i);
     shot.seconds = now() - start;
 

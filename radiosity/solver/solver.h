@@ -4,7 +4,7 @@
 //   for each emitting surface: project its emission; B = dB_unshot = E
 //   while not converged:
 //     shoot from the surface with the largest unshot power  int B_unshot A
-//     every surface that can receive from it gets dB by one transfer (radiosity/transfer/receiver.h),
+//     every surface that can receive from it gets dB by one transfer (radiosity/transfer/transfer.h),
 //       with shadows; B += dB, B_unshot += dB (SplineField::add)
 //     B_unshot of the shooter = 0
 //
@@ -23,7 +23,7 @@
 #include "octree/octree.h"
 #include "radiosity/visibility/hidden_regions.h"
 #include "radiosity/geometry/quadtree.h"
-#include "radiosity/transfer/receiver.h"
+#include "radiosity/transfer/transfer.h"
 #include "radiosity/scene/scene.h"
 #include "radiosity/geometry/spline_field.h"
 
@@ -37,8 +37,10 @@ struct SolverOptions {
     bool self_transfer = false;     // concave curved surfaces receive from themselves
     double tolerance = 2e-3;        // accuracy relative to the scene's radiosity scale: the
                                     //   absolute tolerance of every transfer (see file comment)
-    double quadrature_share = 1;    // the quadrature's absolute tolerance, as a share of it
-    int emission_level = 5;         // level at which a textured emission is projected
+    /// The quadrature's absolute tolerance, as a share of the transfer's (a constant).
+    static constexpr double quadrature_share = 1;
+    /// The level at which a textured emission is projected (a constant).
+    static constexpr int emission_level = 5;
     bool hidden_regions = true;     // beyond the paper: samples at points that see no front
                                     //   face take the nearest visible point's value
                                     //   (radiosity/visibility/hidden_regions.h)
@@ -150,6 +152,26 @@ private:
     std::vector<HiddenMask> hidden_;  // per surface (empty masks when the option is off)
     std::vector<double> last_seconds_;  // per surface: its last transfer's seconds (scheduling)
     Rgb power(int surface, const SplineField& field) const;
+
+    /// What one receiver got from a shot: dB_i, its transfer's counts, the cells its tree split.
+    struct Received {
+        SplineField field;
+        TransferStats stats;
+        std::vector<std::uint64_t> splits;
+    };
+    /// The surfaces that receive from shooter h: every other surface that reflects and faces h
+    /// (front to front), and h itself when it is concave and self_transfer is on.
+    std::vector<int> receivers_of(int h) const;
+    /// One transfer per receiver (section 5), in parallel over receivers or one at a time with
+    /// parallel stages (the paper's shadows); the results do not depend on the order.
+    std::vector<Received> transfer_to(const std::vector<int>& receivers, int h,
+                                      const Shooter& shooter, const ReceiverOptions& options,
+                                      int shot_number);
+    /// Superposition in receiver order: B_i += dB_i, B_unshot_i += dB_i, the measured coupling
+    /// of h to each receiver and the cells split, then B_unshot_h = 0 (or what h received from
+    /// itself). Fills the shot's power and count fields.
+    void superpose(const std::vector<int>& receivers, std::vector<Received>& results, int h,
+                   const Shooter& shooter, ShotStats& shot);
 };
 
 /// Solves the scene: shots until done(), calling on_shot (may be empty) after each.
