@@ -1,8 +1,8 @@
 // math/convex2d.h - convex polygons of the plane: clipping by half-planes, intersection and
 // difference, and a Gauss rule on triangles. The exact visibility of mbr's shadow stage (a
-// shooter's visible part seen from a receiving point, radiosity/visibility/visible_parts.h) is built from these:
-// the shooter's cells cut by the receiving point's horizon and by the central projections of
-// occluders onto the shooter's plane (Sutherland and Hodgman 1974 for the clipping).
+// shooter's visible part seen from a receiving point, radiosity/visibility/visible_parts.h) is
+// built from these: the shooter's cells cut by the receiving point's horizon and by the central
+// projections of occluders onto the shooter's plane (Sutherland and Hodgman 1974 for the clipping).
 #pragma once
 
 #include <vector>

@@ -98,7 +98,7 @@ struct Run {
 
 /// One transfer from the setup's shooter (radiosity 1) to its receiver (reflectance 1).
 inline Run run_transfer(const ShadowSetup& setup, const ReceiverOptions& options,
-                 const OcclusionContext* occlusion) {
+                        const OcclusionContext* occlusion) {
     Run run;
     const SplineField unshot = SplineField::constant(options.m, 0, {1, 1, 1});
     const Shooter shooter = make_shooter(setup.shooter, unshot, options.shooter_coarsening);
@@ -181,8 +181,8 @@ struct Brute {
     long n_capped = 0;
 };
 inline Brute brute_shadowed(Vec3 p, Vec3 n_p, const Surface& shooter,
-                     const std::vector<std::vector<Vec3>>& occluders, double tol, int min_depth,
-                     int cap, unsigned seed) {
+                            const std::vector<std::vector<Vec3>>& occluders, double tol,
+                            int min_depth, int cap, unsigned seed) {
     const GaussLegendre g5 = gauss_legendre(5), g6 = gauss_legendre(6);
     std::mt19937 rng(seed);
     std::uniform_real_distribution<double> jitter(0, 1);

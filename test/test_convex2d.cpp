@@ -253,10 +253,10 @@ TEST_CASE("convex2d: subtract and classify survive a zero-length edge", "[convex
     // An edge of b of zero length would give left_of(b[i], b[i]) = the zero half-plane (value 0
     // everywhere): classify took it for a separating axis and answered disjoint, subtract kept
     // all of `rest` as a piece. Such polygons came out of intersect (test above), which is how
-    // blocked_view makes its shadows (radiosity/visibility/visible_parts.cpp). Input: s = intersect(a, unit
-    // square) with a as above. Expected: classify(s, square) = inside, classify(square, s) =
-    // partial, subtract(square, s) of total area 1 - 0.392323 = 0.607677 (before the fix:
-    // disjoint, disjoint, and 1.60768).
+    // blocked_view makes its shadows (radiosity/visibility/visible_parts.cpp). Input: s =
+    // intersect(a, unit square) with a as above. Expected: classify(s, square) = inside,
+    // classify(square, s) = partial, subtract(square, s) of total area 1 - 0.392323 = 0.607677
+    // (before the fix: disjoint, disjoint, and 1.60768).
     const ConvexPolygon a{{0.5, 0}, {0.8, -0.5}, {1.2, 0.6}, {0.3, 0.7}};
     const ConvexPolygon s = intersect(a, unit_square);
     CAPTURE(s);

@@ -1,7 +1,7 @@
 // test/test_cost.cpp - bounded cost, said before it is spent: the memory estimate of
-// radiosity/solver/cost.h grows with every setting and refuses a run over the budget; an image named by
-// several materials is counted (and decoded) once; a failure inside a parallel loop reaches the
-// caller as an exception; coarsening a deep shooter by every number of levels works.
+// radiosity/solver/cost.h grows with every setting and refuses a run over the budget; an image
+// named by several materials is counted (and decoded) once; a failure inside a parallel loop
+// reaches the caller as an exception; coarsening a deep shooter by every number of levels works.
 #include <algorithm>
 #include <catch2/catch.hpp>
 #include <iostream>
@@ -12,10 +12,10 @@
 #include "examples/common/transfer_cli.h"
 #include "math/check.h"
 #include "math/parallel.h"
-#include "radiosity/solver/cost.h"
-#include "radiosity/transfer/transfer.h"
 #include "radiosity/scene/scene_io.h"
+#include "radiosity/solver/cost.h"
 #include "radiosity/solver/solver.h"
+#include "radiosity/transfer/transfer.h"
 
 using namespace mbr;
 

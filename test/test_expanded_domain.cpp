@@ -85,7 +85,8 @@ double extrapolated(const ReceiverState& state, Vec2 p) {
 
 }  // namespace
 
-TEST_CASE("receiver: edge profiles interpolate linearly between edgefill nodes", "[receiver][expanded_domain]") {
+TEST_CASE("receiver: edge profiles interpolate linearly between edgefill nodes",
+          "[receiver][expanded_domain]") {
     EdgeProfile p;
     p.sigma = {0, 0.25, 1};
     p.value = {{1, 0, 0}, {3, 0, 0}, {0, 0, 0}};
@@ -152,7 +153,8 @@ TEST_CASE("receiver: linear extrapolation (23)-(25) continues value and slope of
         }
 }
 
-TEST_CASE("receiver: linear extrapolation clamps steep derivatives", "[receiver][expanded_domain]") {
+TEST_CASE("receiver: linear extrapolation clamps steep derivatives",
+          "[receiver][expanded_domain]") {
     // Section 6: "If ... too large ... reduced into a predetermined range": here
     // |B_n| <= clamp_factor * max|dB| / h_min = 1 * 1 / 0.25 = 4.
     ReceiverState state = extrapolation_state(Extrapolation::Linear);
@@ -169,7 +171,8 @@ TEST_CASE("receiver: linear extrapolation clamps steep derivatives", "[receiver]
     CHECK(extrapolate(state, 0.5, 1.3).r == Approx(v.r + 0.3 * g_t(0.5, 1)).epsilon(1e-14));
 }
 
-TEST_CASE("receiver: linear extrapolation keeps values near the samples' range", "[receiver][expanded_domain]") {
+TEST_CASE("receiver: linear extrapolation keeps values near the samples' range",
+          "[receiver][expanded_domain]") {
     // clamp_values: each channel of (23)-(25) stays within [lo - w, hi + w] for the samples'
     // range [lo, hi] of width w. With a steep edge (derivative 1e3, as where a surface meets its
     // shooter) the unclamped values 1 unit out would be about 1e3; clamped they are at most
@@ -193,7 +196,8 @@ TEST_CASE("receiver: linear extrapolation keeps values near the samples' range",
     CHECK(near.r == Approx(v.r - 0.01 * d.r).epsilon(1e-12));
 }
 
-TEST_CASE("receiver: higher-order extrapolation meets (26) and (27)", "[receiver][expanded_domain]") {
+TEST_CASE("receiver: higher-order extrapolation meets (26) and (27)",
+          "[receiver][expanded_domain]") {
     // Along the outward normal, in units of the boundary cell w = h_min = 1/4: value and normal
     // derivative continue the edge's; the quadratic form (26) is C^1 at one cell out and zero
     // with zero derivative from two cells on; the cubic form (27) is zero from one cell on.
@@ -236,7 +240,6 @@ TEST_CASE("receiver: higher-order extrapolation meets (26) and (27)", "[receiver
         CHECK(extrapolated(state, {-0.05, -0.05}) != 0);
     }
 }
-
 
 TEST_CASE("receiver: uniform trees keep the expanded cells next to the domain at the leaves' size",
           "[receiver][expanded_domain]") {

@@ -22,8 +22,8 @@
 #include <vector>
 
 #include "math/gauss_legendre.h"
-#include "radiosity/transfer/sample_values.h"
 #include "radiosity/reference/configurations.h"
+#include "radiosity/transfer/sample_values.h"
 #include "test/report.h"
 
 using namespace mbr;

@@ -326,9 +326,9 @@ TEST_CASE("mbr_tool: probe prints B at the points in order: E, zero and rho E F"
     CHECK(count_lines(run.out) == lines.size());  // every row ends with its newline
 
     // The solver's accuracy target: tolerance 1e-3 (the default) times the scene's radiosity
-    // scale, its largest emitted power over the total area (radiosity/solver/solver.h), as an absolute
-    // error of each transfer; exactly one transfer (light to floor) reaches the floor. That is
-    // 2.5e-3 here, about 1% of the values; the errors are at most 5.2e-4 (MBR_TEST_REPORT=1
+    // scale, its largest emitted power over the total area (radiosity/solver/solver.h), as an
+    // absolute error of each transfer; exactly one transfer (light to floor) reaches the floor.
+    // That is 2.5e-3 here, about 1% of the values; the errors are at most 5.2e-4 (MBR_TEST_REPORT=1
     // prints them), and a wrong rho, E, channel order or a mirrored or transposed floor would
     // be off by 0.1 or more.
     const double floor_margin = 1e-3 * emission[2] * light_area / total_area;

@@ -35,19 +35,19 @@ std::string other_value(const OptionSpec& o) {
     const SolverSettings defaults;
     const double d = o.get(defaults);
     switch (o.kind) {
-    case OptionSpec::Kind::Integer:
-        return std::to_string(int(d == o.hi ? o.lo : o.hi));
-    case OptionSpec::Kind::Real: {
-        const double mid = 0.5 * (o.lo + o.hi);
-        std::ostringstream os;
-        os.precision(17);
-        os << (mid == d ? 0.25 * o.lo + 0.75 * o.hi : mid);
-        return os.str();
-    }
-    case OptionSpec::Kind::Choice:
-        return o.choices[d == 0 ? 1 : 0];
-    case OptionSpec::Kind::Switch:
-        return d != 0 ? "false" : "true";
+        case OptionSpec::Kind::Integer:
+            return std::to_string(int(d == o.hi ? o.lo : o.hi));
+        case OptionSpec::Kind::Real: {
+            const double mid = 0.5 * (o.lo + o.hi);
+            std::ostringstream os;
+            os.precision(17);
+            os << (mid == d ? 0.25 * o.lo + 0.75 * o.hi : mid);
+            return os.str();
+        }
+        case OptionSpec::Kind::Choice:
+            return o.choices[d == 0 ? 1 : 0];
+        case OptionSpec::Kind::Switch:
+            return d != 0 ? "false" : "true";
     }
     return "";
 }

@@ -41,8 +41,8 @@ TEST_CASE("receiver: cells touching the shooter split down to contact_depth, and
             double lowest_y = 1e300;
             for (double s : {r.x0, r.x1})
                 for (double t : {r.y0, r.y1})
-                    lowest_y = std::min(lowest_y,
-                                        std::fabs(run.setup.receiver.evaluate(s, t).position.y));
+                    lowest_y =
+                        std::min(lowest_y, std::fabs(run.setup.receiver.evaluate(s, t).position.y));
             if (lowest_y == 0)
                 edge_min = std::min(edge_min, c.level);
             else if (lowest_y >= 0.5)

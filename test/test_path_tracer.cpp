@@ -1,5 +1,5 @@
-// test/test_path_tracer.cpp - the Monte Carlo reference of radiosity/reference/path_tracer.h against
-// closed forms: a closed box whose faces all emit (B = E / (1 - rho) at every point, every
+// test/test_path_tracer.cpp - the Monte Carlo reference of radiosity/reference/path_tracer.h
+// against closed forms: a closed box whose faces all emit (B = E / (1 - rho) at every point, every
 // bounce counts), one bounce under a light quad (B = rho E F with the analytic point-to-polygon
 // form factor), the umbra of an occluder (nothing), textured emission and reflectance; its
 // standard error against the spread of independent runs; and bitwise determinism for any seed
@@ -8,9 +8,9 @@
 #include <cmath>
 #include <vector>
 
-#include "radiosity/transfer/form_factor.h"
 #include "radiosity/reference/path_tracer.h"
 #include "radiosity/scene/scene_octree.h"
+#include "radiosity/transfer/form_factor.h"
 
 using namespace mbr;
 

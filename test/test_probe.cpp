@@ -1,7 +1,7 @@
-// test/test_probe.cpp - probe points (radiosity/reference/probe.h): world points on every surface kind are
-// located at the (u, v) that maps to them, a normal decides between surfaces that meet, a point
-// far from every surface is refused by name, each malformed CSV gets an InputError at its line,
-// and results are written with the exact headers.
+// test/test_probe.cpp - probe points (radiosity/reference/probe.h): world points on every surface
+// kind are located at the (u, v) that maps to them, a normal decides between surfaces that meet, a
+// point far from every surface is refused by name, each malformed CSV gets an InputError at its
+// line, and results are written with the exact headers.
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <fstream>

@@ -229,7 +229,8 @@ Rgb project_brute_force(const ReceiverState& state, const DualTable& dn, const F
 
 }  // namespace
 
-TEST_CASE("receiver: project visits exactly the leaf cells that meet the rhombus", "[receiver][projection]") {
+TEST_CASE("receiver: project visits exactly the leaf cells that meet the rhombus",
+          "[receiver][projection]") {
     // A mixed tree (depth 2, two cells at depth 3, the far ring at level 0) whose leaves carry
     // random constants: project() must equal the sum over exactly the cells meeting the
     // rhombus. Radii 6.3 and 9.7 cells (not dyadic, so no cell touches the rhombus exactly;
@@ -447,7 +448,8 @@ TEST_CASE("receiver: fulcrums for m = 4 on a hand-built tree equal the hand-list
     }
 }
 
-TEST_CASE("receiver: the extra fulcrums of select_fulcrums change no coefficient", "[receiver][projection]") {
+TEST_CASE("receiver: the extra fulcrums of select_fulcrums change no coefficient",
+          "[receiver][projection]") {
     // Unification with the paper's set of fulcrums (the extras left out) gives the same field,
     // bit for bit: a coefficient is the same number whether stored in stage 6 or projected on
     // demand in stage 8.

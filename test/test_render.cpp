@@ -1,6 +1,6 @@
-// test/test_render.cpp - the renderer (radiosity/output/render.h): radiance B / pi of the solved fields
-// (eq. (20)) seen by the camera, one-sided surfaces, jitter that depends on the seed and not on
-// the threads, sRGB tone mapping, Radiance RGBE files and the quadtree overlay.
+// test/test_render.cpp - the renderer (radiosity/output/render.h): radiance B / pi of the solved
+// fields (eq. (20)) seen by the camera, one-sided surfaces, jitter that depends on the seed and not
+// on the threads, sRGB tone mapping, Radiance RGBE files and the quadtree overlay.
 //
 // Independent references: a quad facing the camera squarely, whose (u, v) at a pixel is an affine
 // function of the pixel coordinates worked out by hand; the sRGB decoder of texture.h; stb_image's
@@ -17,10 +17,10 @@
 #include <vector>
 
 #include "math/check.h"
+#include "radiosity/geometry/texture.h"
 #include "radiosity/output/render.h"
 #include "radiosity/scene/scene_io.h"
 #include "radiosity/scene/scene_octree.h"
-#include "radiosity/geometry/texture.h"
 #include "test/report.h"
 
 #ifdef _OPENMP

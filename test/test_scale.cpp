@@ -2,7 +2,8 @@
 // relative size"): the transfers of Tables 1 and 2 (paper section 7) give the same rea of
 // eq. (29) whatever unit the scene is given in, and a shooter far smaller than its receiver is
 // measured as accurately as a small one, with the analytic point-to-polygon form factor
-// (radiosity/transfer/sample_values.h) exact to rounding for a polygon far smaller than its distance.
+// (radiosity/transfer/sample_values.h) exact to rounding for a polygon far smaller than its
+// distance.
 //
 // Independent reference for the tiny polygon: the point-source limit of the form factor,
 // F = A cos(theta_p) cos(theta_x) / (pi r^2) with r from p to the polygon's centroid, whose
@@ -18,13 +19,13 @@
 #include <vector>
 
 #include "examples/common/transfer_cli.h"
-#include "radiosity/visibility/hidden_regions.h"
-#include "radiosity/transfer/sample_values.h"
-#include "radiosity/transfer/transfer.h"
 #include "radiosity/scene/scene_io.h"
 #include "radiosity/scene/scene_octree.h"
-#include "radiosity/visibility/visible_parts.h"
 #include "radiosity/solver/solver.h"
+#include "radiosity/transfer/sample_values.h"
+#include "radiosity/transfer/transfer.h"
+#include "radiosity/visibility/hidden_regions.h"
+#include "radiosity/visibility/visible_parts.h"
 #include "test/report.h"
 
 using namespace mbr;

@@ -81,7 +81,8 @@ TEST_CASE("shadow: an occluder outside the region between the surfaces changes n
                       run_transfer(control.setup, options, nullptr).field) > 0);
 }
 
-TEST_CASE("shadow: a blocker covering the whole shooter makes every coefficient zero", "[shadow][shadows]") {
+TEST_CASE("shadow: a blocker covering the whole shooter makes every coefficient zero",
+          "[shadow][shadows]") {
     // A square [-1, 2]^2 in z = 0.5 between the parallel unit squares: every segment from the
     // receiver to the shooter crosses z = 0.5 inside [0, 1]^2, so VIS = 0 everywhere. Claims:
     // - Fractions: every fraction (28) is exactly 0 (every ray blocked), hence every stored
@@ -140,8 +141,7 @@ TEST_CASE("shadow: an occluder hiding half of a point's view gives a fraction ne
     const SurfacePoint p = setup.receiver.evaluate(0.5, 0.5);
 
     // The partition (28) uses at p, and the statistics above.
-    const IncrementIntegrator::Result r =
-        sampler.integrator(0).integrate(p, true, min_patch_depth);
+    const IncrementIntegrator::Result r = sampler.integrator(0).integrate(p, true, min_patch_depth);
     double E = 0, sum_e2_diag = 0;
     int n_diag = 0;
     for (const auto& patch : r.partition) {

@@ -2,8 +2,8 @@
 // radiosity/solver/solver.h) and its solution files (docs/solution-format.md).
 //
 // Independent references: the power balance of a closed box (everything a shooter sends arrives
-// on some face), the single transfer of radiosity/transfer/transfer.h run by hand with the options the
-// loop gives it, and the analytic point-to-polygon form factor for a first bounce. The scenes
+// on some face), the single transfer of radiosity/transfer/transfer.h run by hand with the options
+// the loop gives it, and the analytic point-to-polygon form factor for a first bounce. The scenes
 // are small and the depths low, so that every test runs in about a second.
 #include <catch2/catch.hpp>
 #include <cmath>
@@ -12,13 +12,13 @@
 #include <vector>
 
 #include "math/check.h"
-#include "radiosity/visibility/hidden_regions.h"
-#include "radiosity/transfer/sample_values.h"
-#include "radiosity/transfer/transfer.h"
 #include "radiosity/scene/scene_io.h"
 #include "radiosity/scene/scene_octree.h"
-#include "radiosity/visibility/visible_parts.h"
 #include "radiosity/solver/solver.h"
+#include "radiosity/transfer/sample_values.h"
+#include "radiosity/transfer/transfer.h"
+#include "radiosity/visibility/hidden_regions.h"
+#include "radiosity/visibility/visible_parts.h"
 #include "test/report.h"
 
 #ifdef _OPENMP
@@ -190,11 +190,12 @@ TEST_CASE("solver: radiosity is never negative or NaN", "[solver]") {
 
 // Known defect, kept visible: [!shouldfail] passes while the check fails; when the solver is
 // fixed, this test fails and the tag must go. A block resting on the floor hides a square of it;
-// the hidden region's samples take the nearest visible values (radiosity/visibility/hidden_regions.h), which are
-// nearly zero in the block's contact shadow, and the floor's spline dips to -0.0044 there
-// (against a largest 0.16, measured on this 65 x 65 grid). The points are hidden (nobody sees
-// them), but the field's power integral includes them. (The Cornell box also dips below zero
-// at visible points, e.g. at the short block's footprint corner and the room's corners.)
+// the hidden region's samples take the nearest visible values
+// (radiosity/visibility/hidden_regions.h), which are nearly zero in the block's contact shadow, and
+// the floor's spline dips to -0.0044 there (against a largest 0.16, measured on this 65 x 65 grid).
+// The points are hidden (nobody sees them), but the field's power integral includes them. (The
+// Cornell box also dips below zero at visible points, e.g. at the short block's footprint corner
+// and the room's corners.)
 TEST_CASE("solver: radiosity is never negative under a block resting on the floor",
           "[solver][!shouldfail]") {
     const Scene scene = shadowed_floor(0.0);

@@ -28,8 +28,8 @@ using namespace mbr::test;
 
 // ---- The whole transfer ---------------------------------------------------------------------
 
-
-TEST_CASE("receiver: transfer leaves each stage's result in a consistent state", "[receiver][transfer]") {
+TEST_CASE("receiver: transfer leaves each stage's result in a consistent state",
+          "[receiver][transfer]") {
     // Parallel squares at h = 0.5, oracle between depths 1 and 3: the state after the run must
     // show every stage's promise (DESIGN.md section 3).
     ReceiverOptions options;
@@ -161,7 +161,6 @@ TEST_CASE("receiver: transfer leaves each stage's result in a consistent state",
                         << "\n";
 }
 
-
 TEST_CASE("receiver: results do not depend on the number of threads", "[receiver][transfer]") {
 #ifdef _OPENMP
     // DESIGN.md section 4: per-thread quadrature caches change speed, never values, and the
@@ -194,7 +193,6 @@ TEST_CASE("receiver: results do not depend on the number of threads", "[receiver
 #endif
 }
 
-
 // ---- The paper's numbers (section 7, Tables 1 and 2) ----------------------------------------
 
 TEST_CASE("receiver: Table 1 row h = 1.0, d = 3 stays below the paper's 0.126 %",
@@ -210,7 +208,8 @@ TEST_CASE("receiver: Table 1 row h = 1.0, d = 3 stays below the paper's 0.126 %"
                         << " % (paper 0.126 %), max " << 100 * e.max_rel << " %\n";
 }
 
-TEST_CASE("receiver: Table 2 row d = 3 stays below the paper's 0.676 %", "[receiver][transfer][paper]") {
+TEST_CASE("receiver: Table 2 row d = 3 stays below the paper's 0.676 %",
+          "[receiver][transfer][paper]") {
     const Run run = run_transfer(perpendicular_squares(), uniform_options(3));
     const ErrorStats e = compare_with_exact(run.field, run.setup);
     CAPTURE(e.rea, e.max_rel);

@@ -1,7 +1,8 @@
-// test/test_tutorial_08.cpp - tutorial chapter 8 (examples/tutorial/tutorial_08_progressive_loop.cpp,
-// docs/tutorial/08-progressive-loop.md) run small: three shots of the Cornell box at receiver
-// depth 3. Checked: who shoots in which order, the energy bookkeeping of every shot, and the
-// key numbers the chapter's page reports at these settings.
+// test/test_tutorial_08.cpp - tutorial chapter 8
+// (examples/tutorial/tutorial_08_progressive_loop.cpp, docs/tutorial/08-progressive-loop.md) run
+// small: three shots of the Cornell box at receiver depth 3. Checked: who shoots in which order,
+// the energy bookkeeping of every shot, and the key numbers the chapter's page reports at these
+// settings.
 #include <catch2/catch.hpp>
 #include <filesystem>
 #include <sstream>

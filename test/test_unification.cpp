@@ -62,7 +62,8 @@ void endpoint_derivatives(const std::function<double(double)>& f, double a, doub
 
 }  // namespace
 
-TEST_CASE("receiver: the unified field is C^(m-2) across leaves of different size", "[receiver][unification]") {
+TEST_CASE("receiver: the unified field is C^(m-2) across leaves of different size",
+          "[receiver][unification]") {
     // Parallel squares at h = 0.1, adaptive depths 1..4 (oracle 2e-3): leaves of two sizes
     // meet (levels 3 and 4, 32 edges between them). Along the normal through points of every edge
     // shared by leaves of different size, the field is one polynomial of degree m - 1 on each side

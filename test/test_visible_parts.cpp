@@ -1,7 +1,7 @@
-// test/test_visible_parts.cpp - exact visibility inside (21) (beyond the paper, ShadowMethod::Exact;
-// radiosity/visibility/visible_parts.h and the IncrementIntegrator of radiosity/transfer/
-// sample_values.h with an OcclusionContext): horizon clipping, visible pieces and
-// occluders_toward, against the analytic shadowed form factor, itself checked against an
+// test/test_visible_parts.cpp - exact visibility inside (21) (beyond the paper,
+// ShadowMethod::Exact; radiosity/visibility/visible_parts.h and the IncrementIntegrator of
+// radiosity/transfer/ sample_values.h with an OcclusionContext): horizon clipping, visible pieces
+// and occluders_toward, against the analytic shadowed form factor, itself checked against an
 // adaptive brute force.
 #include <algorithm>
 #include <catch2/catch.hpp>
@@ -28,7 +28,8 @@ using namespace mbr::test;
 
 // ---- Exact visibility --------------------------------------------------------------------------
 
-TEST_CASE("shadow: shadowed_form_factor agrees with adaptive brute force", "[shadow][visible_parts]") {
+TEST_CASE("shadow: shadowed_form_factor agrees with adaptive brute force",
+          "[shadow][visible_parts]") {
     // The analytic reference (two contour integrals) against the integral of F VIS A over the
     // shooter by an adaptive 5/6-point Gauss rule that splits cells whose nodes or corners
     // disagree on visibility down to level 11 (cells of 1/2048), with an independent
@@ -75,7 +76,8 @@ TEST_CASE("shadow: shadowed_form_factor agrees with adaptive brute force", "[sha
                         << "\n";
 }
 
-TEST_CASE("shadow: exact visibility in (21) matches the shadowed form factor", "[shadow][visible_parts]") {
+TEST_CASE("shadow: exact visibility in (21) matches the shadowed form factor",
+          "[shadow][visible_parts]") {
     // IncrementIntegrator with an occlusion context (ShadowMethod::Exact) at random receiving
     // points of the square and tilted configurations, and of the small shooter (side 0.3) whose
     // occluder casts an umbra on [0.25, 0.75]^2. The rule's tolerance is 1e-4 relative to the
@@ -83,58 +85,60 @@ TEST_CASE("shadow: exact visibility in (21) matches the shadowed form factor", "
     // In the umbra nothing is visible: I is 0. Both the quadrature (the whole minus the hidden
     // part) and the closed form (a constant shooter's default) are checked.
     for (const bool analytic : {false, true}) {
-    CAPTURE(analytic);
-    QuadratureOptions options;
-    options.analytic = analytic;
-    struct Config {
-        const char* name;
-        ShadowSetup setup;
-    };
-    const Config configs[] = {{"square", occluded_squares(0)},
-                              {"tilted", occluded_squares(30)},
-                              {"umbra", occluded_squares(0, 0.3)}};
-    std::mt19937 rng(17);
-    std::uniform_real_distribution<double> unit(0, 1);
-    for (const Config& c : configs) {
-        const Pair pair(c.setup);
-        REQUIRE(pair.context.candidates.size() == 1);
-        const Shooter shooter = unit_shooter(c.setup.shooter);
-        IncrementIntegrator integrator(shooter, options, &pair.context);
-        const std::vector<Vec3> polygon = quad_polygon(c.setup.shooter);
-        double worst = 0;
-        long evaluations = 0, rays = 0;
-        int n_points = 0, n_umbra = 0;
-        for (int i = 0; i < 40; ++i) {
-            const double s = unit(rng), t = unit(rng);
-            const SurfacePoint p = c.setup.receiver.evaluate(s, t);
-            const double full = point_polygon_form_factor(p.position, p.normal, polygon);
-            const double exact =
-                shadowed_form_factor(p.position, p.normal, polygon, c.setup.occluders[0]);
-            const IncrementIntegrator::Result r = integrator.integrate(p);
-            CAPTURE(c.name, s, t, exact, full, r.value.r);
-            CHECK(r.converged);
-            CHECK(std::fabs(r.value.r - exact) <= 1e-4 * full);
-            worst = std::max(worst, std::fabs(r.value.r - exact) / full);
-            evaluations += r.n_evaluations;
-            rays += r.n_rays;
-            ++n_points;
-            if (std::string(c.name) == "umbra" && s > 0.26 && s < 0.74 && t > 0.26 && t < 0.74) {
-                // The closed form sums the visible pieces: none, exactly 0. The quadrature
-                // subtracts the hidden part from the whole (shadow_subtraction): 0 up to
-                // rounding of the two equal integrals.
-                if (analytic)
-                    CHECK(r.value.r == 0);
-                else
-                    CHECK(std::fabs(r.value.r) <= 1e-12 * full);
-                ++n_umbra;
+        CAPTURE(analytic);
+        QuadratureOptions options;
+        options.analytic = analytic;
+        struct Config {
+            const char* name;
+            ShadowSetup setup;
+        };
+        const Config configs[] = {{"square", occluded_squares(0)},
+                                  {"tilted", occluded_squares(30)},
+                                  {"umbra", occluded_squares(0, 0.3)}};
+        std::mt19937 rng(17);
+        std::uniform_real_distribution<double> unit(0, 1);
+        for (const Config& c : configs) {
+            const Pair pair(c.setup);
+            REQUIRE(pair.context.candidates.size() == 1);
+            const Shooter shooter = unit_shooter(c.setup.shooter);
+            IncrementIntegrator integrator(shooter, options, &pair.context);
+            const std::vector<Vec3> polygon = quad_polygon(c.setup.shooter);
+            double worst = 0;
+            long evaluations = 0, rays = 0;
+            int n_points = 0, n_umbra = 0;
+            for (int i = 0; i < 40; ++i) {
+                const double s = unit(rng), t = unit(rng);
+                const SurfacePoint p = c.setup.receiver.evaluate(s, t);
+                const double full = point_polygon_form_factor(p.position, p.normal, polygon);
+                const double exact =
+                    shadowed_form_factor(p.position, p.normal, polygon, c.setup.occluders[0]);
+                const IncrementIntegrator::Result r = integrator.integrate(p);
+                CAPTURE(c.name, s, t, exact, full, r.value.r);
+                CHECK(r.converged);
+                CHECK(std::fabs(r.value.r - exact) <= 1e-4 * full);
+                worst = std::max(worst, std::fabs(r.value.r - exact) / full);
+                evaluations += r.n_evaluations;
+                rays += r.n_rays;
+                ++n_points;
+                if (std::string(c.name) == "umbra" && s > 0.26 && s < 0.74 && t > 0.26 &&
+                    t < 0.74) {
+                    // The closed form sums the visible pieces: none, exactly 0. The quadrature
+                    // subtracts the hidden part from the whole (shadow_subtraction): 0 up to
+                    // rounding of the two equal integrals.
+                    if (analytic)
+                        CHECK(r.value.r == 0);
+                    else
+                        CHECK(std::fabs(r.value.r) <= 1e-12 * full);
+                    ++n_umbra;
+                }
             }
+            CHECK(rays == 0);  // a planar shooter is clipped, not sampled by rays
+            if (std::string(c.name) == "umbra") CHECK(n_umbra >= 5);
+            mbr::test::report() << "shadow exact visibility " << c.name
+                                << (analytic ? " (closed form)" : "") << ": worst |I - exact| / F "
+                                << worst << ", kernel evaluations per point "
+                                << evaluations / n_points << "\n";
         }
-        CHECK(rays == 0);  // a planar shooter is clipped, not sampled by rays
-        if (std::string(c.name) == "umbra") CHECK(n_umbra >= 5);
-        mbr::test::report() << "shadow exact visibility " << c.name << (analytic ? " (closed form)" : "")
-                            << ": worst |I - exact| / F " << worst
-                            << ", kernel evaluations per point " << evaluations / n_points << "\n";
-    }
     }
 }
 
@@ -225,13 +229,13 @@ TEST_CASE("shadow: exact visibility on a curved shooter casts rays and matches t
 
 TEST_CASE("shadow: exact visibility on a curved shooter sees a shadow along a cell's edge",
           "[shadow][visible_parts][!mayfail]") {
-    // KNOWN LIMITATION (radiosity/transfer/sample_values.cpp, IncrementIntegrator::cell_value, curved path): a
-    // cell is split for visibility only when its quadrature nodes disagree; a shadow that covers
-    // only a sliver between the cell's edge and its outermost nodes (up to ~3 % of the cell's
-    // width for n = 6) is never seen. Input: the tilted configuration (occluded_squares(30)) with
-    // the shooter as a bilinear patch (the same flat square), receiving point (s, t) =
-    // (0.8720885877, 0.9264383943), default quadrature options but min_share = 1e-2 and
-    // max_visibility_depth = 8 (for speed: the miss is the same with the defaults, with
+    // KNOWN LIMITATION (radiosity/transfer/sample_values.cpp, IncrementIntegrator::cell_value,
+    // curved path): a cell is split for visibility only when its quadrature nodes disagree; a
+    // shadow that covers only a sliver between the cell's edge and its outermost nodes (up to ~3 %
+    // of the cell's width for n = 6) is never seen. Input: the tilted configuration
+    // (occluded_squares(30)) with the shooter as a bilinear patch (the same flat square), receiving
+    // point (s, t) = (0.8720885877, 0.9264383943), default quadrature options but min_share = 1e-2
+    // and max_visibility_depth = 8 (for speed: the miss is the same with the defaults, with
     // max_visibility_depth 8 .. 12 and min_share 1e-2 .. 1e-4). The shadow's edge runs at 0.0044
     // of the shooter's width beside the line u = 1/2 between the level-1 cells; the right cells'
     // nodes all see the shooter. Expected |I - exact| <= 1e-4 F (the requested tolerance), exact
@@ -318,24 +322,25 @@ TEST_CASE("shadow: exact visibility when a shadow's vertex lies on the shooter's
         REQUIRE(pair.context.candidates.size() == 1);
         const Shooter shooter = unit_shooter(setup.shooter);
         for (const bool analytic : {false, true}) {  // the quadrature and the closed form
-        QuadratureOptions options;
-        options.analytic = analytic;
-        IncrementIntegrator integrator(shooter, options, &pair.context);
-        const std::vector<Vec3> polygon = quad_polygon(setup.shooter);
-        for (double dt : {1e-9, 0.0}) {
-            const SurfacePoint p = setup.receiver.evaluate(0.5, 0.5 + dt);
-            const double full = point_polygon_form_factor(p.position, p.normal, polygon);
-            const double exact =
-                shadowed_form_factor(p.position, p.normal, polygon, setup.occluders[0]);
-            const double I = integrator.integrate(p).value.r;
-            CAPTURE(occluder, analytic, dt, exact, full, I);
-            CHECK(std::fabs(I - exact) <= 1e-4 * full);
-        }
+            QuadratureOptions options;
+            options.analytic = analytic;
+            IncrementIntegrator integrator(shooter, options, &pair.context);
+            const std::vector<Vec3> polygon = quad_polygon(setup.shooter);
+            for (double dt : {1e-9, 0.0}) {
+                const SurfacePoint p = setup.receiver.evaluate(0.5, 0.5 + dt);
+                const double full = point_polygon_form_factor(p.position, p.normal, polygon);
+                const double exact =
+                    shadowed_form_factor(p.position, p.normal, polygon, setup.occluders[0]);
+                const double I = integrator.integrate(p).value.r;
+                CAPTURE(occluder, analytic, dt, exact, full, I);
+                CHECK(std::fabs(I - exact) <= 1e-4 * full);
+            }
         }
     }
 }
 
-TEST_CASE("shadow: visible pieces of the shooter's cells tile its unshadowed part", "[shadow][visible_parts]") {
+TEST_CASE("shadow: visible pieces of the shooter's cells tile its unshadowed part",
+          "[shadow][visible_parts]") {
     // blocked_view, classify_cell and visible_pieces on a grid of 8 x 8 shooter cells: the areas
     // of what each cell shows (all of a clear cell, nothing of a hidden one, the pieces of a cut
     // one) add up to the shooter's area minus the shadow's (one occluder: one shadow polygon,
@@ -377,7 +382,8 @@ TEST_CASE("shadow: visible pieces of the shooter's cells tile its unshadowed par
     }
 }
 
-TEST_CASE("shadow: horizon clipping integrates exactly what the tangent plane leaves", "[shadow][visible_parts]") {
+TEST_CASE("shadow: horizon clipping integrates exactly what the tangent plane leaves",
+          "[shadow][visible_parts]") {
     // Receivers whose tangent plane cuts a planar shooter: (a) the perpendicular squares with the
     // shooter extended below the receiver's plane (z from -0.5 to 1), (b) a receiver tilted by
     // 60 degrees under the parallel shooter at h = 1. The analytic point_polygon_form_factor
@@ -518,8 +524,8 @@ TEST_CASE("shadow: occluders_toward with a limit gives the whole list or more th
     polygons.push_back(make_polygon(quad_polygon(shooter), 0));
     polygons.push_back(make_polygon(quad_polygon(receiver), 1));
     for (int i = 0; i < 150; ++i)
-        polygons.push_back(make_polygon(
-            random_triangle(rng, {u(rng), u(rng), 0.1 + 0.8 * u(rng)}, 0.08), 2 + i));
+        polygons.push_back(
+            make_polygon(random_triangle(rng, {u(rng), u(rng), 0.1 + 0.8 * u(rng)}, 0.08), 2 + i));
     const Octree octree(polygons, OctreeOptions{6, 4});
     const OcclusionContext ctx = make_occlusion_context(octree, shooter, 0, receiver, 1, 0);
     REQUIRE(static_cast<int>(ctx.candidates.size()) > exact_limit);

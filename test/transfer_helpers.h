@@ -23,7 +23,6 @@
 
 namespace mbr::test {
 
-
 // ---- A receiver state built by hand ---------------------------------------------------------
 
 /// Splits every domain leaf down to `depth`.
@@ -159,7 +158,7 @@ inline Poly random_poly(int m, std::mt19937& rng) {
 /// integer knots; the sums of this monotone-enveloped tail are accurate to a few per mille, and a
 /// factor 1.1 covers it).
 inline double projection_error_bound(const DualTable& dn, double r, double h, double c,
-                              const std::vector<double>& abs_a, int m) {
+                                     const std::vector<double>& abs_a, int m) {
     const double delta = 1.0 / 32;
     const int N = static_cast<int>(std::ceil(dn.half_width() / delta));
     std::vector<double> x(N), D(N);
@@ -214,7 +213,7 @@ inline std::vector<double> fulcrum_reach(const ReceiverState& state) {
 /// near the domain is at least that fine; leaving them out makes the bound stricter, never
 /// looser.
 inline double field_error_bound(const ReceiverState& state, const DualTable& dn,
-                         const std::vector<double>& abs_a) {
+                                const std::vector<double>& abs_a) {
     const std::vector<double> reach = fulcrum_reach(state);
     int min_level = 64;
     for (int index : state.forest.leaves(Forest::Region::Domain))
@@ -253,8 +252,6 @@ inline void build_mixed_domain(Forest& forest, int d) {
     split_to(forest, DyadicCell{d + 1, 2 * n - 1, n});
     adjust_neighbour_scales(forest, Forest::Region::Domain);
 }
-
-
 
 /// One transfer as the examples run it: shooter radiosity 1 (its unshot field coarsened as
 /// section 6 does), receiver reflectance 1.

@@ -18,8 +18,8 @@
 #include <streambuf>
 
 #include "math/check.h"
-#include "radiosity/solver/cost.h"
 #include "radiosity/output/output_file.h"
+#include "radiosity/solver/cost.h"
 
 namespace mbr {
 

@@ -71,7 +71,8 @@ double parse_memory_size(const std::string& text, const std::string& what);
 struct CostEstimate;
 /// Usage line of --memory-budget.
 extern const char* memory_budget_usage;
-/// "--memory-budget X" (parse_memory_size), default default_memory_budget() (radiosity/solver/cost.h).
+/// "--memory-budget X" (parse_memory_size), default default_memory_budget()
+/// (radiosity/solver/cost.h).
 double read_memory_budget(Args& args);
 /// Says the cost before it is spent: UsageError "<run> needs about N, more than the memory
 /// budget B ..." when cost.bytes exceeds the budget; otherwise, when `slow`, one warning line on

@@ -12,11 +12,11 @@
 
 #include "math/check.h"
 #include "math/parallel.h"
-#include "radiosity/solver/cost.h"
 #include "radiosity/output/image.h"
 #include "radiosity/output/output_file.h"
 #include "radiosity/scene/scene_io.h"
 #include "radiosity/scene/scene_octree.h"
+#include "radiosity/solver/cost.h"
 
 #ifdef _OPENMP
 #include <omp.h>
@@ -28,8 +28,8 @@ std::string solver_options_usage() {
     return "  SCENE                     a scene file (docs/scene-format.md)\n" + option_usage() +
            "  --threads n               OpenMP threads, 1..256 (default: all cores)\n"
            "  --quiet                   no progress bar\n"
-           "  --memory-budget X         refuse a run estimated to need more memory (bytes, or K, M,\n"
-           "                            G, T: 4G; default half the physical memory)\n";
+           "  --memory-budget X         refuse a run estimated to need more memory (bytes, or\n"
+           "                            K, M, G, T: 4G; default half the physical memory)\n";
 }
 
 namespace {

@@ -54,8 +54,9 @@ std::vector<std::string> summary_cells(const SolveStats& stats);
 void write_summary_csv(std::ostream& os, const SolveStats& stats);
 
 /// Renders the solution with the scene's camera (radiance B / pi, sRGB tone mapping with
-/// options.exposure) and writes it as a PNG to `path` (all or nothing, radiosity/output/output_file.h).
-/// InputError when the scene has no camera. Returns the render's seconds.
+/// options.exposure) and writes it as a PNG to `path` (all or nothing,
+/// radiosity/output/output_file.h). InputError when the scene has no camera. Returns the render's
+/// seconds.
 double write_render(const SceneRun& run, const Solution& solution, const std::string& path,
                     const RenderOptions& options = {});
 

@@ -5,8 +5,8 @@
 #include <string>
 
 #include "examples/common/cli.h"
-#include "radiosity/transfer/transfer.h"
 #include "radiosity/reference/configurations.h"
+#include "radiosity/transfer/transfer.h"
 
 namespace mbr {
 

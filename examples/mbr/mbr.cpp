@@ -26,8 +26,8 @@
 #include "examples/common/transfer_cli.h"
 #include "math/check.h"
 #include "radiosity/output/output_file.h"
-#include "radiosity/reference/probe.h"
 #include "radiosity/output/render.h"
+#include "radiosity/reference/probe.h"
 
 #ifndef MBR_VERSION
 #define MBR_VERSION "unknown"

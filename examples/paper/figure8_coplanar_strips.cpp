@@ -1,8 +1,8 @@
-// examples/paper/figure8_coplanar_strips.cpp - Figures 8 and 9 of the paper (section 7): three narrow
-// coplanar rectangles lit from above, each solved on its own. "We can not see any discontinuity
-// of radiosity at boundaries between adjacent rectangles. It indicates that the technique of
-// function extrapolation in this paper can keep a certain degree of continuity between coplanar
-// surfaces." Here the continuity is measured.
+// examples/paper/figure8_coplanar_strips.cpp - Figures 8 and 9 of the paper (section 7): three
+// narrow coplanar rectangles lit from above, each solved on its own. "We can not see any
+// discontinuity of radiosity at boundaries between adjacent rectangles. It indicates that the
+// technique of function extrapolation in this paper can keep a certain degree of continuity between
+// coplanar surfaces." Here the continuity is measured.
 //
 // Run:  figure8_coplanar_strips [SCENE] [--csv] [--points n] [-o FILE.png]
 //                               [--image linear|higher] [solver options]
@@ -33,8 +33,8 @@
 
 #include "examples/common/cli.h"
 #include "examples/common/scene_cli.h"
-#include "radiosity/transfer/form_factor.h"
 #include "radiosity/output/output_file.h"
+#include "radiosity/transfer/form_factor.h"
 
 namespace mbr {
 namespace {

@@ -15,4 +15,6 @@ const char* usage =
     "  --eps E  agreement of successive inverses (default 1e-12)\n";
 }  // namespace
 
-int main(int argc, char** argv) { return mbr::run_main(argc, argv, usage, mbr::run_table3); }
+int main(int argc, char** argv) {
+    return mbr::run_main(argc, argv, usage, mbr::run_table3);
+}

@@ -1,6 +1,6 @@
-// examples/studies/adaptive_subdivision.cpp - the oracle of section 6 at work: rea against the number of
-// receiver leaves for several oracle thresholds, beside uniform trees of depth 2..5, on the
-// parallel squares at h = 0.1 (Table 1's hardest case), for both rules of scale unification:
+// examples/studies/adaptive_subdivision.cpp - the oracle of section 6 at work: rea against the
+// number of receiver leaves for several oracle thresholds, beside uniform trees of depth 2..5, on
+// the parallel squares at h = 0.1 (Table 1's hardest case), for both rules of scale unification:
 // the paper's (coarse coefficients refined by (17)) and projection of every finest-scale
 // coefficient.
 //
@@ -37,7 +37,8 @@ int run(mbr::Args& args) {
     if (!(h > 0 && h < 100)) throw UsageError("--h must be in (0, 100)");
     const TransferSetup setup = parallel_squares(h);
 
-    Table table({"tree", "unification", "oracle_tolerance", "leaves", "samples", "rea_percent", "seconds"});
+    Table table(
+        {"tree", "unification", "oracle_tolerance", "leaves", "samples", "rea_percent", "seconds"});
     auto add = [&](const std::string& tree, const ReceiverOptions& o, const TransferRun& run) {
         table.add_row({tree, o.unify_by_projection ? "projection" : "paper (17)",
                        tree == "uniform" ? "" : cell_g(o.oracle_tolerance, 2),
@@ -56,7 +57,11 @@ int run(mbr::Args& args) {
             uniform4_leaves = run.stats.n_leaves;
         }
     }
-    struct Best { int leaves = 0; double rea = 0; double tol = 0; };
+    struct Best {
+        int leaves = 0;
+        double rea = 0;
+        double tol = 0;
+    };
     Best best[2];
     for (int rule = 0; rule < 2; ++rule)
         for (double tol : {1e-2, 5e-3, 3e-3, 2e-3, 1e-3, 5e-4, 3e-4, 1e-4}) {
@@ -68,7 +73,8 @@ int run(mbr::Args& args) {
             const TransferRun run = run_transfer(setup, o);
             add("adaptive", o, run);
             // The smallest adaptive tree that reaches uniform depth 4's rea.
-            if (run.errors.rea <= uniform4_rea && (best[rule].leaves == 0 || run.stats.n_leaves < best[rule].leaves))
+            if (run.errors.rea <= uniform4_rea &&
+                (best[rule].leaves == 0 || run.stats.n_leaves < best[rule].leaves))
                 best[rule] = {run.stats.n_leaves, run.errors.rea, tol};
         }
     if (csv) {
@@ -95,4 +101,6 @@ int run(mbr::Args& args) {
 
 }  // namespace
 
-int main(int argc, char** argv) { return mbr::run_main(argc, argv, usage(), run); }
+int main(int argc, char** argv) {
+    return mbr::run_main(argc, argv, usage(), run);
+}

@@ -1,5 +1,5 @@
-// examples/studies/closed_box_check.cpp - the closed-box checks of the whole-scene solver (paper section
-// 4; DESIGN.md section 6): two cubes whose answers are known without any form factor.
+// examples/studies/closed_box_check.cpp - the closed-box checks of the whole-scene solver (paper
+// section 4; DESIGN.md section 6): two cubes whose answers are known without any form factor.
 //
 // Run:  closed_box_check [--csv] [--grid n] [solver options]
 //
@@ -20,18 +20,18 @@
 // unshot power of a face below 1e-6 of the emitted; at most 2000 shots) and a tighter
 // tolerance than the solver's default: 5e-4 of the radiosity scale (the default is 2e-3),
 // with the Interpolation test of the oracle in cells that touch the shooter (`set
-// contact_oracle interpolation`; the solver's default is the paper's test). A cube is all contact: every face
-// meets four others, and next to a shared edge and most of all at a corner B changes on the
-// scale of the distance to the edge. There the two means of the paper's oracle agree long
+// contact_oracle interpolation`; the solver's default is the paper's test). A cube is all contact:
+// every face meets four others, and next to a shared edge and most of all at a corner B changes on
+// the scale of the distance to the edge. There the two means of the paper's oracle agree long
 // before the spline follows B, and a tighter tolerance does not help it: the largest error of
 // the means test is 1.31 % at 2e-3, 1.30 % at 1e-3 and 2.78 % at 5e-4, where the
 // interpolation test gives 1.61 %, 1.26 % and 0.41 % (docs/method.md). The solver's other
 // defaults hold (order 4, depths 1..6, exact shadows, hidden regions, the ambient correction).
 // Every solver option of the other scene programs can override them (--tolerance 2e-3
-// --contact-oracle means gives the solver's defaults). The text output shows each case with and without the ambient correction (the
-// constant radiosity per face that sends on the power still unshot at the end, SolverOptions::
-// ambient): both come from the same shots. --csv prints the case as configured (--ambient, on
-// by default) under the header
+// --contact-oracle means gives the solver's defaults). The text output shows each case with and
+// without the ambient correction (the constant radiosity per face that sends on the power still
+// unshot at the end, SolverOptions:: ambient): both come from the same shots. --csv prints the case
+// as configured (--ambient, on by default) under the header
 //   case,mean_rel_err_percent,max_rel_err_percent,energy_rel_err_percent,shots,seconds
 // with the cases `uniform` and `top_light` (the top light has no pointwise reference: its
 // mean and max cells are empty).
@@ -253,10 +253,10 @@ int run(Args& args) {
               << ", depths " << o.receiver.min_depth << ".." << o.receiver.max_depth
               << ", tolerance " << o.tolerance << ", contact oracle "
               << (o.receiver.contact_oracle_test == OracleTest::Interpolation ? "interpolation"
-                                                                               : "means")
-              << ", convergence " << o.convergence
-              << ", clamp_values " << (o.receiver.clamp_values ? "on" : "off") << ", at most "
-              << o.max_shots << " shots; grid " << n << " x " << n << " cell centres per face\n"
+                                                                              : "means")
+              << ", convergence " << o.convergence << ", clamp_values "
+              << (o.receiver.clamp_values ? "on" : "off") << ", at most " << o.max_shots
+              << " shots; grid " << n << " x " << n << " cell centres per face\n"
               << "targets: uniform mean <= 0.1 %, max <= 1 %; top light energy <= 0.1 %\n\n";
     for (const CaseResult& r : cases) {
         print_case(std::cout, r, ambient_on);

@@ -1,5 +1,5 @@
-// examples/studies/cornell_accuracy.cpp - how close to a path-traced reference mbr's radiosity of the
-// Cornell box is, and what it costs, at a ladder of accuracy settings (each solved from
+// examples/studies/cornell_accuracy.cpp - how close to a path-traced reference mbr's radiosity of
+// the Cornell box is, and what it costs, at a ladder of accuracy settings (each solved from
 // scratch).
 //
 // The reference: examples/data/cornell_reference_points.csv, path-traced radiosity at 16
@@ -31,8 +31,8 @@
 #include "examples/common/scene_cli.h"
 #include "math/check.h"
 #include "radiosity/output/output_file.h"
-#include "radiosity/reference/probe.h"
 #include "radiosity/output/render.h"
+#include "radiosity/reference/probe.h"
 
 namespace mbr {
 namespace {

@@ -1,5 +1,5 @@
-// examples/studies/cornell_box.cpp - the Cornell box solved by progressive refinement (paper section 4)
-// with shadows, its statistics, and a picture.
+// examples/studies/cornell_box.cpp - the Cornell box solved by progressive refinement (paper
+// section 4) with shadows, its statistics, and a picture.
 //
 // Run:  cornell_box [SCENE] [--per-shot] [--csv] [-o FILE.png] [solver options]
 // Solves examples/scenes/cornell_box.scene (or SCENE) until the unshot power is below the
@@ -46,8 +46,8 @@ int run(Args& args) {
     if (!out.empty()) {
         const double seconds = write_render(run, solution, out);
         // The CSV stays one table; the note goes to stderr then.
-        (csv ? std::cerr : std::cout) << "wrote " << out << " (rendered in " << cell(seconds, 2)
-                                      << " s)\n";
+        (csv ? std::cerr : std::cout)
+            << "wrote " << out << " (rendered in " << cell(seconds, 2) << " s)\n";
     }
     return 0;
 }

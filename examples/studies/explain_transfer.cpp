@@ -431,8 +431,8 @@ std::vector<std::string> sheet_subtitle(const Explained& E, int width, int s) {
     const ReceiverOptions& o = E.state.options;
     return wrap_text(describe(o) + "; oracle depths " + std::to_string(o.min_depth) + ".." +
                          std::to_string(o.max_depth) + ", tolerance " +
-                         cell_g(o.oracle_tolerance, 3) + "; rea = " +
-                         cell_g(100 * E.errors.rea, 3) + " %.",
+                         cell_g(o.oracle_tolerance, 3) +
+                         "; rea = " + cell_g(100 * E.errors.rea, 3) + " %.",
                      width, s);
 }
 

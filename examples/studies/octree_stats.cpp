@@ -1,10 +1,10 @@
-// examples/studies/octree_stats.cpp - the paper's octree (section 6, "Octree") over a scene: its size,
-// and the work it saves ray queries against a loop over every polygon.
+// examples/studies/octree_stats.cpp - the paper's octree (section 6, "Octree") over a scene: its
+// size, and the work it saves ray queries against a loop over every polygon.
 //
-// The scene's surfaces are tessellated at its `tessellation` setting (radiosity/scene/scene_octree.h)
-// and the octree is built over the polygons. Two kinds of seeded random rays are cast, each
-// through the octree and through a brute-force loop over all polygons (Polygon::intersect on
-// every one; any_hit stops at the first hit), and the answers are compared:
+// The scene's surfaces are tessellated at its `tessellation` setting
+// (radiosity/scene/scene_octree.h) and the octree is built over the polygons. Two kinds of seeded
+// random rays are cast, each through the octree and through a brute-force loop over all polygons
+// (Polygon::intersect on every one; any_hit stops at the first hit), and the answers are compared:
 // - closest_hit (rendering): origins uniform in the scene's bounding box, directions uniform on
 //   the sphere; they probe the tree everywhere, from inside and between the objects.
 // - any_hit (shadow rays, eq. (28)): a segment between two points drawn uniformly by area on the

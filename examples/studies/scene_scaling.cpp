@@ -22,10 +22,11 @@
 //                  convergence stop, no ambient correction, so that every size does the same
 //                  number of shots), with its transfers, kernel evaluations and shadow rays;
 //                  shots_s is the time in the shots, setup_s the rest (the emission's
-//                  projection and the hidden-region masks of every surface, radiosity/visibility/hidden_regions.h).
-//                  The lamp shoots first, then the brightest walls and block tops; each shot
-//                  reaches every surface in front of its shooter, so the transfers per shot, and
-//                  the cost of a linear method, grow in proportion to N.
+//                  projection and the hidden-region masks of every surface,
+//                  radiosity/visibility/hidden_regions.h). The lamp shoots first, then the
+//                  brightest walls and block tops; each shot reaches every surface in front of its
+//                  shooter, so the transfers per shot, and the cost of a linear method, grow in
+//                  proportion to N.
 // A cost per quad (seconds / N) that stays flat as N grows is linear behaviour.
 //
 // Run:    scene_scaling [--sizes 1000,10000,100000,200000] [--rays N] [--seed S] [--keep]
@@ -361,7 +362,8 @@ Row measure(const fs::path& dir, int n_quads, int n_rays, int seed, const SolveS
 
     if (solve.shots > 0 && n_quads <= solve.max_quads) {
         mbr::SolverSettings settings = scene.settings;
-        mbr::apply_setting(settings, *mbr::find_option("shadows"), solve.shadows, "--solve-shadows");
+        mbr::apply_setting(settings, *mbr::find_option("shadows"), solve.shadows,
+                           "--solve-shadows");
         mbr::SolverOptions options = mbr::solver_options(settings);
         options.max_shots = solve.shots;
         options.convergence = 0;  // never stop early: the same number of shots at every size

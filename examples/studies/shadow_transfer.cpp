@@ -1,5 +1,5 @@
-// examples/studies/shadow_transfer.cpp - one shadowed energy transfer against its exact answer (paper
-// section 5 "Adaptive Subdivision in Shadow Computation", section 6 "Shadow", eq. (28)).
+// examples/studies/shadow_transfer.cpp - one shadowed energy transfer against its exact answer
+// (paper section 5 "Adaptive Subdivision in Shadow Computation", section 6 "Shadow", eq. (28)).
 //
 // Parallel unit squares at h = 1: the receiver [0,1]^2 in z = 0 (reflectance 1), the shooter
 // [0,1]^2 in z = 1 facing down (radiosity 1), and an opaque occluder between them:
@@ -219,7 +219,8 @@ int run(Args& args) {
         configs.push_back({"custom", setup});
     }
     ReceiverOptions options = read_receiver_options(args);
-    options.shadows.rays_per_patch = args.integer("--rays", options.shadows.rays_per_patch, 1, 4096);
+    options.shadows.rays_per_patch =
+        args.integer("--rays", options.shadows.rays_per_patch, 1, 4096);
     options.shadows.threshold = args.number("--threshold", options.shadows.threshold);
     options.oracle_tolerance = args.number("--oracle-tolerance", options.oracle_tolerance);
     const std::string oracle = args.text("--oracle", "means");

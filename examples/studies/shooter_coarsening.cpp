@@ -4,11 +4,12 @@
 // wavelet analysis to remove higher resolution details").
 //
 // Two bounces: a small light 0.3 above one corner of the floor A lights A (uniform depth d, so
-// B_A is a level-d spline with a sharp peak); then A shoots to the ceiling B at height 1. The second transfer is run with A's field coarsened by c = 0, 1, ..., d levels
-// (orthogonal projection, math/wavelet.h). The reference is the same transfer with c = 0 and a
-// quadrature tolerance 100 times tighter; the table gives the mean and largest relative
-// difference from it on the 256 x 256 grid of B, the relative change of the shot power, and
-// the cost: kernel evaluations and seconds.
+// B_A is a level-d spline with a sharp peak); then A shoots to the ceiling B at height 1. The
+// second transfer is run with A's field coarsened by c = 0, 1, ..., d levels (orthogonal
+// projection, math/wavelet.h). The reference is the same transfer with c = 0 and a quadrature
+// tolerance 100 times tighter; the table gives the mean and largest relative difference from it on
+// the 256 x 256 grid of B, the relative change of the shot power, and the cost: kernel evaluations
+// and seconds.
 //
 // Run:    shooter_coarsening [--depth d] [--order m] [--csv]
 // Expect: every level of coarsening removes detail the quadrature would have to resolve, so
@@ -17,8 +18,8 @@
 #include <iostream>
 
 #include "examples/common/cli.h"
-#include "radiosity/transfer/transfer.h"
 #include "radiosity/reference/configurations.h"
+#include "radiosity/transfer/transfer.h"
 
 namespace {
 
@@ -38,8 +39,8 @@ int run(mbr::Args& args) {
     const bool csv = args.flag("--csv");
     args.finish();
 
-    const Surface light = Surface::planar_quad({0.1, 0.1, 0.3}, {0.1, 0.4, 0.3}, {0.4, 0.4, 0.3},
-                                               {0.4, 0.1, 0.3});
+    const Surface light =
+        Surface::planar_quad({0.1, 0.1, 0.3}, {0.1, 0.4, 0.3}, {0.4, 0.4, 0.3}, {0.4, 0.1, 0.3});
     const Surface floor = Surface::planar_quad({0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0});
     // The ceiling at height 1 facing down: no shared edge, so the only roughness the
     // quadrature meets is the detail of the shooter's field.
@@ -59,10 +60,12 @@ int run(mbr::Args& args) {
     auto shoot = [&](int levels, double tolerance, TransferStats* stats) {
         ReceiverOptions o = second;
         o.quadrature.rel_tolerance = tolerance;
-        return transfer(make_shooter(floor, floor_field, levels), ReceiverSurface{&ceiling, white}, o, stats);
+        return transfer(make_shooter(floor, floor_field, levels), ReceiverSurface{&ceiling, white},
+                        o, stats);
     };
     auto power = [&](const SplineField& f) {
-        return f.integrate_weighted([&](double s, double t) { return floor.area_factor(s, t); }, m).r;
+        return f.integrate_weighted([&](double s, double t) { return floor.area_factor(s, t); }, m)
+            .r;
     };
     const SplineField reference = shoot(0, second.quadrature.rel_tolerance / 100, nullptr);
     const std::vector<double> ref_grid = field_grid(reference, 256);
@@ -99,4 +102,6 @@ int run(mbr::Args& args) {
 
 }  // namespace
 
-int main(int argc, char** argv) { return mbr::run_main(argc, argv, usage, run); }
+int main(int argc, char** argv) {
+    return mbr::run_main(argc, argv, usage, run);
+}

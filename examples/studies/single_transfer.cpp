@@ -1,5 +1,5 @@
-// examples/studies/single_transfer.cpp - the measurement behind Tables 1 and 2 for any two planar quads:
-// one transfer from a shooter of radiosity 1 to a receiver of reflectance 1, compared on the
+// examples/studies/single_transfer.cpp - the measurement behind Tables 1 and 2 for any two planar
+// quads: one transfer from a shooter of radiosity 1 to a receiver of reflectance 1, compared on the
 // 256 x 256 grid of cell centres of the receiver's own (u,v) domain with the analytic
 // point-to-polygon form factor; rea of eq. (29), the largest relative error, and the cost.
 //
@@ -27,14 +27,15 @@ std::string usage() {
                "  --shooter x0 y0 z0 x1 y1 z1 x2 y2 z2 x3 y3 z3   corners at (u,v) = (0,0) (1,0)\n"
                "                            (1,1) (0,1) (default: the unit square at z = 1,\n"
                "                            facing down)\n"
-               "  --receiver ...            the same (default: the unit square at z = 0, facing up)\n"
+               "  --receiver ...            the same (default: the unit square at z = 0,\n"
+               "                            facing up)\n"
                "  --depth d                 uniform receiver depth, 0..12 (default 3)\n"
                "  --adaptive                oracle subdivision instead (section 6)\n"
                "  --oracle-tolerance T      oracle threshold (default 1e-3)\n"
                "  --min-depth a --max-depth b   bounds of the adaptive tree, 0..12 (default 1, 6)\n"
                "  --grid N                  error grid, 2..4096 (default 256)\n"
-               "  --csv                     header rea_percent,max_rel_percent,leaves,coefficients,\n"
-               "                            kernel_evals,seconds\n") +
+               "  --csv                     header rea_percent,max_rel_percent,leaves,\n"
+               "                            coefficients,kernel_evals,seconds\n") +
            mbr::receiver_options_usage + mbr::memory_budget_usage;
 }
 
@@ -61,12 +62,14 @@ int run(mbr::Args& args) {
     // The two fronts must face each other somewhere (tested at the corners: a receiver that
     // straddles the shooter's plane gets energy on its part in front), or nothing is transferred.
     if (!fronts_face_each_other(setup.shooter, setup.receiver))
-        throw UsageError("the shooter and the receiver do not face each other (no corner of one "
-                         "lies in front of the other)");
+        throw UsageError(
+            "the shooter and the receiver do not face each other (no corner of one "
+            "lies in front of the other)");
 
     const TransferRun run = run_transfer(setup, options, grid);
     if (run.errors.n_points == 0) throw UsageError("the receiver gets no energy from the shooter");
-    Table table({"rea_percent", "max_rel_percent", "leaves", "coefficients", "kernel_evals", "seconds"});
+    Table table(
+        {"rea_percent", "max_rel_percent", "leaves", "coefficients", "kernel_evals", "seconds"});
     table.add_row({cell(100 * run.errors.rea, 4), cell(100 * run.errors.max_rel, 4),
                    std::to_string(run.stats.n_leaves), std::to_string(run.n_coefficients),
                    std::to_string(run.stats.n_kernel_evals), cell(run.stats.seconds_total, 3)});
@@ -76,8 +79,9 @@ int run(mbr::Args& args) {
     }
     const TransferStats& s = run.stats;
     std::cout << "single transfer, " << describe(options) << "\n"
-              << (adaptive ? "  adaptive receiver tree, oracle tolerance " + cell_g(options.oracle_tolerance, 3) +
-                                 ", depths " + std::to_string(options.min_depth) + ".." +
+              << (adaptive ? "  adaptive receiver tree, oracle tolerance " +
+                                 cell_g(options.oracle_tolerance, 3) + ", depths " +
+                                 std::to_string(options.min_depth) + ".." +
                                  std::to_string(options.max_depth)
                            : "  uniform receiver depth " + std::to_string(options.max_depth))
               << "\n\n";
@@ -98,4 +102,6 @@ int run(mbr::Args& args) {
 
 }  // namespace
 
-int main(int argc, char** argv) { return mbr::run_main(argc, argv, usage(), run); }
+int main(int argc, char** argv) {
+    return mbr::run_main(argc, argv, usage(), run);
+}

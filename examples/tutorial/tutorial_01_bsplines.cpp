@@ -1,5 +1,5 @@
-// examples/tutorial/tutorial_01_bsplines.cpp - tutorial chapter 1 (docs/tutorial/01-bsplines.md): the
-// uniform B-splines N_m of the paper's section 3, their two-scale relation (14), the refinement
+// examples/tutorial/tutorial_01_bsplines.cpp - tutorial chapter 1 (docs/tutorial/01-bsplines.md):
+// the uniform B-splines N_m of the paper's section 3, their two-scale relation (14), the refinement
 // of a coefficient sequence (15)-(17), and the values at dyadic points (18).
 //
 // Run:  tutorial_01_bsplines [-o DIR] [--order M] [--level J]

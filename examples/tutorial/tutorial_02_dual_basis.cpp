@@ -1,6 +1,7 @@
-// examples/tutorial/tutorial_02_dual_basis.cpp - tutorial chapter 2 (docs/tutorial/02-dual-basis.md): the
-// dual basis DN_m of the B-spline N_m (paper section 3, eqs. (5), (13); Figure 1), computed by the
-// appendix's method (eqs. (30)-(32)) and checked against the paper's Table 3.
+// examples/tutorial/tutorial_02_dual_basis.cpp - tutorial chapter 2
+// (docs/tutorial/02-dual-basis.md): the dual basis DN_m of the B-spline N_m (paper section 3, eqs.
+// (5), (13); Figure 1), computed by the appendix's method (eqs. (30)-(32)) and checked against the
+// paper's Table 3.
 //
 // Run:  tutorial_02_dual_basis [-o DIR] [--eps E]
 //

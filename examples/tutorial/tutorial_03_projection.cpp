@@ -1,8 +1,8 @@
-// examples/tutorial/tutorial_03_projection.cpp - tutorial chapter 3 (docs/tutorial/03-projection.md):
-// projecting a known function onto tensor B-splines with the dual basis, eq. (19), then
-// reconstructing it with (20); how the error falls with the scale 2^-j for a smooth function,
-// one with a kink and one with a step; and what cutting the dual functions off at the rhombus
-// radius (section 5 "Projection", Figure 3) saves and costs.
+// examples/tutorial/tutorial_03_projection.cpp - tutorial chapter 3
+// (docs/tutorial/03-projection.md): projecting a known function onto tensor B-splines with the dual
+// basis, eq. (19), then reconstructing it with (20); how the error falls with the scale 2^-j for a
+// smooth function, one with a kink and one with a step; and what cutting the dual functions off at
+// the rhombus radius (section 5 "Projection", Figure 3) saves and costs.
 //
 // Run:  tutorial_03_projection [-o DIR] [--order M] [--levels J0 J1] [--level J] [--eps E]
 //
@@ -55,9 +55,9 @@ std::vector<TestFunction> test_functions() {
 }
 
 // Eq. (19) for every basis function of level j that touches [0,1]^2, by the library's stage 6
-// (radiosity/transfer/projection.h: project). In a transfer, project() integrates the samples of (21) over
-// the leaves of an adaptive quadtree; here the tree is uniform at level j, wide enough for every
-// rhombus, and its samples are f at the m x m Gauss-Legendre nodes of each leaf.
+// (radiosity/transfer/projection.h: project). In a transfer, project() integrates the samples of
+// (21) over the leaves of an adaptive quadtree; here the tree is uniform at level j, wide enough
+// for every rhombus, and its samples are f at the m x m Gauss-Legendre nodes of each leaf.
 SplineField project_function(const std::function<double(double, double)>& f, int m, int j,
                              double radius, const DualTable& dn) {
     ReceiverOptions options;
@@ -92,7 +92,8 @@ SplineField project_function(const std::function<double(double, double)>& f, int
 }
 
 // Max and root-mean-square of f - f_hat on a 129 x 129 grid over [0,1]^2 (eq. 20, evaluated
-// through radiosity/geometry/spline_field.h: PolynomialPatches, the field as one polynomial per cell).
+// through radiosity/geometry/spline_field.h: PolynomialPatches, the field as one polynomial per
+// cell).
 struct Error {
     double max = 0, rms = 0;
 };

@@ -1,14 +1,17 @@
-// examples/tutorial/tutorial_04_sample_values.cpp - tutorial chapter 4 (docs/tutorial/04-sample-values.md):
-// one transfer, part 1. The receiver learns about the shooter only through sample values, eq.
-// (21): dB(s0, t0) = rho * int int F(p, x(u,v)) B_h(u,v) A_h(u,v) du dv, with the kernel F of
-// eq. (3). This program takes the Table 1 configuration (parallel unit squares at distance h,
-// shooter radiosity B_h = 1, reflectance rho = 1, so dB is the point-to-square form factor) and
-//   1. evaluates the kernel (3) at two shooter points (form_factor_kernel, radiosity/transfer/form_factor.h);
+// examples/tutorial/tutorial_04_sample_values.cpp - tutorial chapter 4
+// (docs/tutorial/04-sample-values.md): one transfer, part 1. The receiver learns about the shooter
+// only through sample values, eq. (21): dB(s0, t0) = rho * int int F(p, x(u,v)) B_h(u,v) A_h(u,v)
+// du dv, with the kernel F of eq. (3). This program takes the Table 1 configuration (parallel unit
+// squares at distance h, shooter radiosity B_h = 1, reflectance rho = 1, so dB is the
+// point-to-square form factor) and
+//   1. evaluates the kernel (3) at two shooter points (form_factor_kernel,
+//   radiosity/transfer/form_factor.h);
 //   2. evaluates (21) by adaptive Gauss-Legendre quadrature (section 6) at two receiving points
 //      for a ladder of tolerances, and compares with the analytic form factor
 //      (point_polygon_form_factor): kernel evaluations against error, plain rule
 //      (adaptive_integrate_2d, math/gauss_legendre.h) beside the library's IncrementIntegrator;
-//   3. runs the oracle of section 6 (subdivide_by_oracle, radiosity/transfer/oracle.h), which decides
+//   3. runs the oracle of section 6 (subdivide_by_oracle, radiosity/transfer/oracle.h), which
+//   decides
 //      where the receiver needs small cells, and draws its tree over dB.
 // Run: tutorial_04_sample_values [-o DIR] [--h H] [--min-depth a] [--max-depth b]
 //                                [--oracle-tolerance T]
@@ -20,8 +23,8 @@
 
 #include "examples/common/cli.h"
 #include "examples/common/plot.h"
-#include "radiosity/transfer/transfer.h"
 #include "radiosity/reference/configurations.h"
+#include "radiosity/transfer/transfer.h"
 
 namespace mbr {
 namespace {
@@ -210,7 +213,7 @@ int run(Args& args) {
     for (const DyadicCell& c : {DyadicCell{0, 0, 0}, DyadicCell{3, 3, 3}, DyadicCell{3, 0, 0}})
         print_oracle_test(sampler, c, options.m);
 
-    ReceiverState state(options);  // stages 1-2 only: no rhombus radius
+    ReceiverState state(options);         // stages 1-2 only: no rhombus radius
     subdivide_by_oracle(state, sampler);  // stage 1
     std::map<int, int> per_level;
     for (int index : state.forest.leaves(Forest::Region::Domain))
@@ -231,7 +234,8 @@ int run(Args& args) {
                                      cell_g(options.oracle_tolerance, 3) + ": " +
                                      std::to_string(n_leaves) + " leaves over dB");
     write_png((std::filesystem::path(dir) / "tutorial_04_oracle_tree.png").string(), tree);
-    std::cout << "\nwrote " << dir << "/tutorial_04_quadrature.png and " << dir << "/tutorial_04_oracle_tree.png\n";
+    std::cout << "\nwrote " << dir << "/tutorial_04_quadrature.png and " << dir
+              << "/tutorial_04_oracle_tree.png\n";
     return 0;
 }
 

@@ -6,7 +6,8 @@
 // (22) along the four edges, the expanded domain (eight patches around [0,1]^2, Figure 5) is
 // subdivided and sampled by extrapolation, linear (23)-(25) or higher order (26)-(27). This
 // program, on the Table 1 configuration at a uniform depth,
-//   1. runs stages 1-3 (radiosity/transfer/transfer.h) and checks the edgefill profile of the bottom edge
+//   1. runs stages 1-3 (radiosity/transfer/transfer.h) and checks the edgefill profile of the
+//   bottom edge
 //      against the analytic form factor and its derivative;
 //   2. builds the expanded domain (expand_domain) and counts its leaves per patch and level;
 //   3. finishes the transfer with each continuation: none (zero outside), linear, quadratic (26),
@@ -21,8 +22,8 @@
 
 #include "examples/common/cli.h"
 #include "examples/common/plot.h"
-#include "radiosity/transfer/transfer.h"
 #include "radiosity/reference/configurations.h"
+#include "radiosity/transfer/transfer.h"
 
 namespace mbr {
 namespace {
@@ -272,7 +273,8 @@ int run(Args& args) {
     plot.add_vline(1, {{0.3, 0.3, 0.3}, 1, 4, 4});
     Image profiles(900, 560, {1, 1, 1});
     plot.draw(profiles, {0, 0, 900, 560});
-    write_png((std::filesystem::path(dir) / "tutorial_05_extrapolation_profiles.png").string(), profiles);
+    write_png((std::filesystem::path(dir) / "tutorial_05_extrapolation_profiles.png").string(),
+              profiles);
     std::cout << "\nwrote " << dir << "/tutorial_05_expanded_domain.png and " << dir
               << "/tutorial_05_extrapolation_profiles.png\n";
     return 0;

@@ -4,7 +4,8 @@
 // (Figure 2), each coefficient is the projection (19) onto a dual basis function truncated to a
 // rhombus (Figure 3), and coefficients of different scales are unified to the finest by (17).
 // On parallel squares at h = 0.1 with an adaptive tree (leaves of two sizes), this program
-//   1. selects the fulcrums (select_fulcrums, radiosity/transfer/projection.h) and counts them per level;
+//   1. selects the fulcrums (select_fulcrums, radiosity/transfer/projection.h) and counts them per
+//   level;
 //   2. gives the rhombus radius for a ladder of truncations (DualTable::rhombus_radius) and
 //      projects one coefficient with each (project), against the widest;
 //   3. projects all selected coefficients (project_in_rhombi), unifies the scales
@@ -253,7 +254,8 @@ int run(Args& args) {
     Image truncation(860, 520, {1, 1, 1});
     plot.draw(truncation, {0, 0, 860, 520});
     write_png((std::filesystem::path(dir) / "tutorial_06_truncation.png").string(), truncation);
-    std::cout << "\nwrote " << dir << "/tutorial_06_fulcrums.png and " << dir << "/tutorial_06_truncation.png\n";
+    std::cout << "\nwrote " << dir << "/tutorial_06_fulcrums.png and " << dir
+              << "/tutorial_06_truncation.png\n";
     return 0;
 }
 

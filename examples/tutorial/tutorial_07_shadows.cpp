@@ -11,8 +11,8 @@
 //      to a maximum shadow depth, and every coefficient is multiplied by its fraction
 //      (apply_shadows, radiosity/transfer/shadows.cpp).
 // The exact shadowed value at a receiving point is known in closed form (the form factor of the
-// shooter minus that of the occluder's projection onto it, radiosity/reference/configurations.h), so we can
-// measure the error of (28) and watch it, and the ray count, as the shadow depth grows.
+// shooter minus that of the occluder's projection onto it, radiosity/reference/configurations.h),
+// so we can measure the error of (28) and watch it, and the ray count, as the shadow depth grows.
 //
 // Run:  tutorial_07_shadows [-o DIR] [--depths a b] [--tilt DEG] [--shooter-side S]
 //                           [--rays R] [--threshold T] [--grid n]
@@ -27,9 +27,9 @@
 #include "examples/common/plot.h"
 #include "octree/octree.h"
 #include "radiosity/output/image.h"
+#include "radiosity/reference/configurations.h"
 #include "radiosity/transfer/sample_values.h"
 #include "radiosity/transfer/transfer.h"
-#include "radiosity/reference/configurations.h"
 #include "radiosity/visibility/visible_parts.h"
 
 namespace mbr {

@@ -2,8 +2,8 @@
 // from the solved coefficients to a picture, and how true the picture is.
 //
 // Chapter 8 left every surface with a SplineField: the coefficients of eq. (20). Rendering is
-// what the paper calls trivial and leaves out; mbr does it in radiosity/output/render.h: a camera ray
-// per sample finds the first surface (the octree of section 6 again), eq. (20) gives B_i(u, v)
+// what the paper calls trivial and leaves out; mbr does it in radiosity/output/render.h: a camera
+// ray per sample finds the first surface (the octree of section 6 again), eq. (20) gives B_i(u, v)
 // there, and a Lambertian surface sends radiance L = B / pi toward the eye. tone_map turns
 // radiance into sRGB display values, write_png stores them (the `mbr render` tool does the same).
 //
@@ -28,8 +28,8 @@
 
 #include "examples/common/cli.h"
 #include "examples/common/plot.h"
-#include "radiosity/reference/probe.h"
 #include "radiosity/output/render.h"
+#include "radiosity/reference/probe.h"
 #include "radiosity/scene/scene_io.h"
 #include "radiosity/scene/scene_octree.h"
 #include "radiosity/solver/solver.h"

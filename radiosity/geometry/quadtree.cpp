@@ -1,4 +1,5 @@
-// radiosity/geometry/quadtree.cpp - dyadic cells and the forest of quadtrees over the parameter plane.
+// radiosity/geometry/quadtree.cpp - dyadic cells and the forest of quadtrees over the parameter
+// plane.
 #include "radiosity/geometry/quadtree.h"
 
 #include <cmath>
@@ -14,7 +15,9 @@ int floor_div_pow2(int i, int levels) {
 }
 }  // namespace
 
-double DyadicCell::size() const { return std::ldexp(1.0, -level); }
+double DyadicCell::size() const {
+    return std::ldexp(1.0, -level);
+}
 
 Rect DyadicCell::rect() const {
     const double h = size();

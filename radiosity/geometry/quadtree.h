@@ -1,5 +1,5 @@
-// radiosity/geometry/quadtree.h - the hierarchical structures of a receiver's parameter plane (paper
-// section 5: "Upon the domain R[a,b;c,d] and each patch of the expanded domain, there is a
+// radiosity/geometry/quadtree.h - the hierarchical structures of a receiver's parameter plane
+// (paper section 5: "Upon the domain R[a,b;c,d] and each patch of the expanded domain, there is a
 // hierarchical structure constructed during subdivision").
 //
 // Every cell is a dyadic square (level L, index i, j) = [i 2^-L, (i+1) 2^-L] x [j 2^-L, (j+1) 2^-L]
@@ -41,7 +41,7 @@ public:
         DyadicCell cell;
         int first_child = -1;  // index of child (0,0); children (1,0), (0,1), (1,1) follow
         int parent = -1;
-        int samples = -1;      // index of the leaf's m x m samples, -1 when not computed
+        int samples = -1;        // index of the leaf's m x m samples, -1 when not computed
         bool resampled = false;  // its samples were resampled from its parent's polynomial (a
                                  //   leaf made by shadow subdivision), not computed by (21)
         bool is_leaf() const { return first_child < 0; }

@@ -96,7 +96,8 @@ void SplineField::evaluate_grid(const double* s, int n_s, const double* t, int n
             if (l >= g0.first_l && l < g0.first_l + g0.n_l)
                 for (int i = 0; i < m_; ++i) {
                     const int k = fk + i;
-                    if (k >= g0.first_k && k < g0.first_k + g0.n_k) sum += bs[i] * coefficient(k, l);
+                    if (k >= g0.first_k && k < g0.first_k + g0.n_k)
+                        sum += bs[i] * coefficient(k, l);
                 }
             row[l - l_lo] = sum;
         }
@@ -131,18 +132,22 @@ PolynomialPatches::PolynomialPatches(const SplineField& field) {
             for (int col = 0; col < m; ++col) {
                 int piv = col;
                 for (int row = col + 1; row < m; ++row)
-                    if (std::fabs(A[size_t(row) * m + col]) > std::fabs(A[size_t(piv) * m + col])) piv = row;
-                for (int k = 0; k < m; ++k) std::swap(A[size_t(col) * m + k], A[size_t(piv) * m + k]);
+                    if (std::fabs(A[size_t(row) * m + col]) > std::fabs(A[size_t(piv) * m + col]))
+                        piv = row;
+                for (int k = 0; k < m; ++k)
+                    std::swap(A[size_t(col) * m + k], A[size_t(piv) * m + k]);
                 std::swap(b[col], b[piv]);
                 for (int row = col + 1; row < m; ++row) {
                     const double f = A[size_t(row) * m + col] / A[size_t(col) * m + col];
-                    for (int k = col; k < m; ++k) A[size_t(row) * m + k] -= f * A[size_t(col) * m + k];
+                    for (int k = col; k < m; ++k)
+                        A[size_t(row) * m + k] -= f * A[size_t(col) * m + k];
                     b[row] -= f * b[col];
                 }
             }
             for (int row = m - 1; row >= 0; --row) {
                 double s = b[row];
-                for (int k = row + 1; k < m; ++k) s -= A[size_t(row) * m + k] * P[size_t(r) * m + k];
+                for (int k = row + 1; k < m; ++k)
+                    s -= A[size_t(row) * m + k] * P[size_t(r) * m + k];
                 P[size_t(r) * m + row] = s / A[size_t(row) * m + row];
             }
         }
@@ -194,7 +199,8 @@ Rgb horner_cell(const double* C, int m_runtime, double lx, double ly) {
 Rgb PolynomialPatches::operator()(double s, double t) const {
     if (c_.empty()) return {};
     const double x = std::clamp(s, 0.0, 1.0) * cells_, y = std::clamp(t, 0.0, 1.0) * cells_;
-    const int i = std::min(cells_ - 1, static_cast<int>(x)), j = std::min(cells_ - 1, static_cast<int>(y));
+    const int i = std::min(cells_ - 1, static_cast<int>(x)),
+              j = std::min(cells_ - 1, static_cast<int>(y));
     const double lx = x - i, ly = y - j;
     const double* C = &c_[(size_t(j) * cells_ + i) * 3 * m_ * m_];
     return m_ == 4 ? horner_cell<4>(C, 4, lx, ly) : horner_cell<0>(C, m_, lx, ly);
@@ -276,8 +282,8 @@ Rgb SplineField::integrate_weighted(const std::function<double(double, double)>&
         for (int cj = 0; cj < cells; ++cj) {
             Rect r{double(ci) / cells, double(ci + 1) / cells, double(cj) / cells,
                    double(cj + 1) / cells};
-            sum += integrate_2d([&](double s, double t) { return w(s, t) * evaluate(s, t); }, r,
-                                rule);
+            sum +=
+                integrate_2d([&](double s, double t) { return w(s, t) * evaluate(s, t); }, r, rule);
         }
     return sum;
 }

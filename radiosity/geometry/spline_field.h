@@ -76,7 +76,8 @@ public:
 
 private:
     int m_ = 0, cells_ = 0;
-    std::vector<double> c_;  // cell (i, j), x^p y^q, channel ch: c_[(j * cells + i) * 3 m^2 + (p m + q) 3 + ch]
+    std::vector<double>
+        c_;  // cell (i, j), x^p y^q, channel ch: c_[(j * cells + i) * 3 m^2 + (p m + q) 3 + ch]
 };
 
 }  // namespace mbr

@@ -46,8 +46,8 @@ Surface Surface::bilinear_patch(Vec3 p00, Vec3 p10, Vec3 p11, Vec3 p01) {
     return s;
 }
 
-Surface Surface::cylinder(Vec3 base, Vec3 axis, Vec3 e1, double radius, double height,
-                          double phi0, double phi1, bool inward) {
+Surface Surface::cylinder(Vec3 base, Vec3 axis, Vec3 e1, double radius, double height, double phi0,
+                          double phi1, bool inward) {
     MBR_CHECK(radius > 0 && height > 0 && phi1 != phi0);
     Surface s;
     s.kind_ = Kind::Cylinder;
@@ -218,7 +218,8 @@ double Surface::area() const {
                 for (int cj = 0; cj < cells; ++cj) {
                     const Rect r{double(ci) / cells, double(ci + 1) / cells, double(cj) / cells,
                                  double(cj + 1) / cells};
-                    sum += integrate_2d([&](double u, double v) { return area_factor(u, v); }, r, rule);
+                    sum += integrate_2d([&](double u, double v) { return area_factor(u, v); }, r,
+                                        rule);
                 }
             return sum;
         }
@@ -316,7 +317,8 @@ std::vector<Facet> Surface::tessellate(int resolution) const {
                 f.vertices.push_back(x[c]);
                 f.uv.push_back(q[c]);
             }
-            if (f.vertices.size() >= 2 && length(f.vertices.back() - f.vertices.front()) <= 1e-12 * r1_) {
+            if (f.vertices.size() >= 2 &&
+                length(f.vertices.back() - f.vertices.front()) <= 1e-12 * r1_) {
                 f.vertices.pop_back();
                 f.uv.pop_back();
             }

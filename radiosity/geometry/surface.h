@@ -1,8 +1,8 @@
-// radiosity/geometry/surface.h - parametric surfaces on the rectilinear domain [0,1]^2 (paper section 2,
-// eqs. (3)-(4); DESIGN.md section 5). Each gives the point x(u,v), the unit normal
-// n = x_u x x_v / |x_u x x_v| (surfaces are one-sided: they emit and receive on the side n
-// points to), the area factor A(u,v) = |x_u x x_v| of eq. (4), a bounding box, its area, and a
-// tessellation into planar facets for ray casting.
+// radiosity/geometry/surface.h - parametric surfaces on the rectilinear domain [0,1]^2 (paper
+// section 2, eqs. (3)-(4); DESIGN.md section 5). Each gives the point x(u,v), the unit normal n =
+// x_u x x_v / |x_u x x_v| (surfaces are one-sided: they emit and receive on the side n points to),
+// the area factor A(u,v) = |x_u x x_v| of eq. (4), a bounding box, its area, and a tessellation
+// into planar facets for ray casting.
 #pragma once
 
 #include <vector>
@@ -13,9 +13,9 @@ namespace mbr {
 
 /// Everything the kernel (2)-(4) needs of one surface point.
 struct SurfacePoint {
-    Vec3 position;             // x(u,v)
-    Vec3 normal;               // unit normal, the front side
-    double area_factor = 0;    // A(u,v) = |x_u x x_v|, eq. (4)
+    Vec3 position;           // x(u,v)
+    Vec3 normal;             // unit normal, the front side
+    double area_factor = 0;  // A(u,v) = |x_u x x_v|, eq. (4)
 };
 
 /// One planar piece of a tessellation with the (u,v) of each corner (3 or 4 corners,
@@ -81,11 +81,11 @@ public:
 
 private:
     Kind kind_ = Kind::PlanarQuad;
-    Vec3 p_[4];                  // quad corners; for the others p_[0] is the centre/base
-    Vec3 e1_, e2_, e3_;          // orthonormal frame (e3 = axis, pole or normal)
-    double r0_ = 0, r1_ = 0;     // radius (r1_) or radii, height in r0_ for cylinders
-    double a0_ = 0, a1_ = 0;     // first angle range (phi for cylinder/disk, theta for sphere)
-    double b0_ = 0, b1_ = 0;     // second angle range (phi for sphere)
+    Vec3 p_[4];               // quad corners; for the others p_[0] is the centre/base
+    Vec3 e1_, e2_, e3_;       // orthonormal frame (e3 = axis, pole or normal)
+    double r0_ = 0, r1_ = 0;  // radius (r1_) or radii, height in r0_ for cylinders
+    double a0_ = 0, a1_ = 0;  // first angle range (phi for cylinder/disk, theta for sphere)
+    double b0_ = 0, b1_ = 0;  // second angle range (phi for sphere)
     bool inward_ = false;
 };
 

@@ -1,6 +1,6 @@
-// radiosity/geometry/texture.h - a reflectance rho_i(s,t) or emission E_i(s,t) field over a surface's
-// parameter domain [0,1]^2 (paper eqs. (1)-(2): "our algorithm does not require albedo to be
-// constant over a surface", section 8). Three kinds: a constant RGB, a procedural checker, and
+// radiosity/geometry/texture.h - a reflectance rho_i(s,t) or emission E_i(s,t) field over a
+// surface's parameter domain [0,1]^2 (paper eqs. (1)-(2): "our algorithm does not require albedo to
+// be constant over a surface", section 8). Three kinds: a constant RGB, a procedural checker, and
 // an image (PNG, JPEG, ... through stb_image) looked up bilinearly.
 #pragma once
 

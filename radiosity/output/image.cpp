@@ -1,5 +1,5 @@
-// radiosity/output/image.cpp - PNG output with stb_image_write (Debian libstb-dev), encoded in memory:
-// stb's file writer does not check fwrite or fclose, so it is never given a file.
+// radiosity/output/image.cpp - PNG output with stb_image_write (Debian libstb-dev), encoded in
+// memory: stb's file writer does not check fwrite or fclose, so it is never given a file.
 #include "radiosity/output/image.h"
 
 #include <stb_image_write.h>

@@ -1,6 +1,6 @@
-// radiosity/output/image.h - an RGB image and PNG output through stb_image_write. The PNG is encoded
-// in memory and written by write_file (radiosity/output/output_file.h): all or nothing, every write
-// checked, so a full disk or a missing folder never leaves a partial image behind.
+// radiosity/output/image.h - an RGB image and PNG output through stb_image_write. The PNG is
+// encoded in memory and written by write_file (radiosity/output/output_file.h): all or nothing,
+// every write checked, so a full disk or a missing folder never leaves a partial image behind.
 #pragma once
 
 #include <string>

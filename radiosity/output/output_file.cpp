@@ -1,5 +1,5 @@
-// radiosity/output/output_file.cpp - all-or-nothing file output (rules in output_file.h). Written on
-// the POSIX calls rather than iostreams or stdio so that every failure keeps its errno: stdio
+// radiosity/output/output_file.cpp - all-or-nothing file output (rules in output_file.h). Written
+// on the POSIX calls rather than iostreams or stdio so that every failure keeps its errno: stdio
 // forgets a failed write once its buffer is dropped, and stb's own writer checks nothing.
 #include "radiosity/output/output_file.h"
 

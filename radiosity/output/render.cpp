@@ -1,5 +1,5 @@
-// radiosity/output/render.cpp - the camera's view of the solved radiosity (eq. (20), radiance B / pi of
-// Lambertian surfaces), tone mapping, Radiance RGBE files and the quadtree overlay.
+// radiosity/output/render.cpp - the camera's view of the solved radiosity (eq. (20), radiance B /
+// pi of Lambertian surfaces), tone mapping, Radiance RGBE files and the quadtree overlay.
 #include "radiosity/output/render.h"
 
 #include <algorithm>

@@ -12,10 +12,10 @@
 
 #include "math/vec3.h"
 #include "octree/octree.h"
-#include "radiosity/output/image.h"
 #include "radiosity/geometry/quadtree.h"
-#include "radiosity/scene/scene.h"
 #include "radiosity/geometry/spline_field.h"
+#include "radiosity/output/image.h"
+#include "radiosity/scene/scene.h"
 
 namespace mbr {
 

@@ -1,12 +1,12 @@
-// radiosity/reference/configurations.cpp - the paper's test configurations and the error metric (29).
+// radiosity/reference/configurations.cpp - the paper's test configurations and the error metric
+// (29).
 #include "radiosity/reference/configurations.h"
 
 #include <algorithm>
 #include <cmath>
 
-#include "math/convex2d.h"
-
 #include "math/check.h"
+#include "math/convex2d.h"
 #include "math/parallel.h"
 #include "radiosity/transfer/form_factor.h"
 
@@ -37,7 +37,8 @@ std::vector<double> exact_grid(const TransferSetup& setup, int n, double scale) 
     parallel_for(n, [&](int j) {
         for (int i = 0; i < n; ++i) {
             const SurfacePoint p = setup.receiver.evaluate((i + 0.5) / n, (j + 0.5) / n);
-            out[size_t(j) * n + i] = scale * point_polygon_form_factor(p.position, p.normal, polygon);
+            out[size_t(j) * n + i] =
+                scale * point_polygon_form_factor(p.position, p.normal, polygon);
         }
     });
     return out;
@@ -116,7 +117,8 @@ std::vector<double> exact_shadowed_grid(const ShadowSetup& setup, int n) {
 std::vector<double> field_grid(const SplineField& field, int n) {
     std::vector<double> out(size_t(n) * n);
     parallel_for(n, [&](int j) {
-        for (int i = 0; i < n; ++i) out[size_t(j) * n + i] = field.evaluate((i + 0.5) / n, (j + 0.5) / n).r;
+        for (int i = 0; i < n; ++i)
+            out[size_t(j) * n + i] = field.evaluate((i + 0.5) / n, (j + 0.5) / n).r;
     });
     return out;
 }

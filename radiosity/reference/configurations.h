@@ -1,13 +1,12 @@
-// radiosity/reference/configurations.h - what checks one transfer (paper section 7, DESIGN.md section 6): the
-// paper's test configurations (unit squares, parallel at distance h or perpendicular with a
-// shared edge) and the relative error metric rea of eq. (29) on a grid of receiver points,
-// against the analytic point-to-polygon form factor.
+// radiosity/reference/configurations.h - what checks one transfer (paper section 7, DESIGN.md
+// section 6): the paper's test configurations (unit squares, parallel at distance h or
+// perpendicular with a shared edge) and the relative error metric rea of eq. (29) on a grid of
+// receiver points, against the analytic point-to-polygon form factor.
 #pragma once
 
 #include <vector>
 
 #include "math/vec3.h"
-
 #include "radiosity/geometry/spline_field.h"
 #include "radiosity/geometry/surface.h"
 
@@ -29,10 +28,10 @@ TransferSetup perpendicular_squares();
 
 /// The errors of eq. (29) on an n x n grid of cell centres of the receiver's (s,t) domain.
 struct ErrorStats {
-    double rea = 0;          // mean of |B_spline - B_exact| / B_exact, eq. (29)
-    double max_rel = 0;      // largest relative error on the grid
-    double mean_exact = 0;   // grid mean of B_exact (the area form factor, times B rho)
-    int n_points = 0;        // grid points with B_exact > 0 (the others are skipped)
+    double rea = 0;         // mean of |B_spline - B_exact| / B_exact, eq. (29)
+    double max_rel = 0;     // largest relative error on the grid
+    double mean_exact = 0;  // grid mean of B_exact (the area form factor, times B rho)
+    int n_points = 0;       // grid points with B_exact > 0 (the others are skipped)
 };
 
 /// Compares the red channel of `field` with B_exact = rho * B_h * F(p -> shooter polygon);

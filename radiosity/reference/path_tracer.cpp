@@ -334,18 +334,22 @@ std::vector<RadiosityEstimate> estimate_radiosity(const Scene& scene, const Octr
     const long n_blocks = (options.paths + options.paths_per_block - 1) / options.paths_per_block;
     const long n_items = static_cast<long>(points.size()) * n_blocks;
     std::vector<Moments> blocks(n_items);
-    parallel_for(n_items, [&](long item) {
-        const long point = item / n_blocks, block = item % n_blocks;
-        const long first = block * options.paths_per_block;
-        const long last = std::min(options.paths, first + options.paths_per_block);
-        Moments moments;
-        for (long path = first; path < last; ++path) {
-            PathRng rng(options.seed, static_cast<std::uint64_t>(point),
-                        static_cast<std::uint64_t>(path));
-            moments.add(trace_path(ctx, points[point], options.min_bounces_before_roulette, rng));
-        }
-        blocks[item] = moments;
-    }, thread_count(options.threads));
+    parallel_for(
+        n_items,
+        [&](long item) {
+            const long point = item / n_blocks, block = item % n_blocks;
+            const long first = block * options.paths_per_block;
+            const long last = std::min(options.paths, first + options.paths_per_block);
+            Moments moments;
+            for (long path = first; path < last; ++path) {
+                PathRng rng(options.seed, static_cast<std::uint64_t>(point),
+                            static_cast<std::uint64_t>(path));
+                moments.add(
+                    trace_path(ctx, points[point], options.min_bounces_before_roulette, rng));
+            }
+            blocks[item] = moments;
+        },
+        thread_count(options.threads));
 
     std::vector<RadiosityEstimate> estimates(points.size());
     for (size_t point = 0; point < points.size(); ++point) {

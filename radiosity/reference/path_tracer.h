@@ -1,6 +1,6 @@
-// radiosity/reference/path_tracer.h - an independent Monte Carlo estimate of the radiosity of eq. (1) at
-// chosen surface points, to check the solver on any scene. It solves the same equation over the
-// same scene and octree, diffuse and one-sided as the paper's surfaces (section 2):
+// radiosity/reference/path_tracer.h - an independent Monte Carlo estimate of the radiosity of eq.
+// (1) at chosen surface points, to check the solver on any scene. It solves the same equation over
+// the same scene and octree, diffuse and one-sided as the paper's surfaces (section 2):
 //   B(p) = E(p) + rho(p) int_{hemisphere at p} L_in(p, w) cos(theta) dw,
 //   L_in(p, w) = B(x) / pi at the first surface point x hit in direction w if x's front faces p,
 //   else 0 (a back face absorbs),

@@ -1,5 +1,5 @@
-// radiosity/reference/probe.cpp - probe points (probe.h): the CSV reader, locating world points on the
-// parametric surfaces of paper section 2, and the CSV writer of results.
+// radiosity/reference/probe.cpp - probe points (probe.h): the CSV reader, locating world points on
+// the parametric surfaces of paper section 2, and the CSV writer of results.
 #include "radiosity/reference/probe.h"
 
 #include <algorithm>

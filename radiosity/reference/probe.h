@@ -1,7 +1,7 @@
-// radiosity/reference/probe.h - probe points: world points where a user wants the radiosity B of eq. (1),
-// to check mbr against an independent estimate (path_tracer.h) or against other renderers. A
-// CSV of named points is read, each point is located on the nearest surface as (surface, u, v)
-// of the parametric map of paper section 2, and results are written back as CSV.
+// radiosity/reference/probe.h - probe points: world points where a user wants the radiosity B of
+// eq. (1), to check mbr against an independent estimate (path_tracer.h) or against other renderers.
+// A CSV of named points is read, each point is located on the nearest surface as (surface, u, v) of
+// the parametric map of paper section 2, and results are written back as CSV.
 #pragma once
 
 #include <iosfwd>

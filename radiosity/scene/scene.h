@@ -1,7 +1,7 @@
-// radiosity/scene/scene.h - the scene model as plain structs (DESIGN.md sections 1, 4, 5): materials
-// with reflectance rho_i and emission E_i (eq. (1)), surfaces on [0,1]^2 (section 2), a camera,
-// and the solver settings of its `set` lines (settings.h). Reading and validating scene files is
-// scene_io.h's work.
+// radiosity/scene/scene.h - the scene model as plain structs (DESIGN.md sections 1, 4, 5):
+// materials with reflectance rho_i and emission E_i (eq. (1)), surfaces on [0,1]^2 (section 2), a
+// camera, and the solver settings of its `set` lines (settings.h). Reading and validating scene
+// files is scene_io.h's work.
 #pragma once
 
 #include <string>

@@ -1,7 +1,7 @@
-// radiosity/scene/scene_octree.h - from a scene to the paper's octree (section 6, "Octree"; DESIGN.md
-// section 5): every surface tessellated into planar polygons that carry the surface's index and
-// the (u, v) of their vertices, so that a ray's hit names a point of a surface, and the octree
-// built over them for the shadow rays of eq. (28) and for rendering.
+// radiosity/scene/scene_octree.h - from a scene to the paper's octree (section 6, "Octree";
+// DESIGN.md section 5): every surface tessellated into planar polygons that carry the surface's
+// index and the (u, v) of their vertices, so that a ray's hit names a point of a surface, and the
+// octree built over them for the shadow rays of eq. (28) and for rendering.
 #pragma once
 
 #include <vector>

@@ -186,15 +186,16 @@ std::string OptionSpec::flag() const {
 
 std::string OptionSpec::range_text() const {
     switch (kind) {
-    case Kind::Integer:
-        return "integer " + std::to_string((long long)lo) + ".." + std::to_string((long long)hi);
-    case Kind::Real:
-        return std::string(open_lo ? "(" : "[") + number_text(lo) + ", " + number_text(hi) +
-               (open_hi ? ")" : "]");
-    case Kind::Choice:
-        return word_list(choices, "");
-    case Kind::Switch:
-        return "true or false (on or off)";
+        case Kind::Integer:
+            return "integer " + std::to_string((long long)lo) + ".." +
+                   std::to_string((long long)hi);
+        case Kind::Real:
+            return std::string(open_lo ? "(" : "[") + number_text(lo) + ", " + number_text(hi) +
+                   (open_hi ? ")" : "]");
+        case Kind::Choice:
+            return word_list(choices, "");
+        case Kind::Switch:
+            return "true or false (on or off)";
     }
     return "";
 }
@@ -202,14 +203,14 @@ std::string OptionSpec::range_text() const {
 std::string OptionSpec::value_text(const SolverSettings& s) const {
     const double x = get(s);
     switch (kind) {
-    case Kind::Integer:
-        return std::to_string((long long)x);
-    case Kind::Real:
-        return number_text(x);
-    case Kind::Choice:
-        return choices[size_t(x)];
-    case Kind::Switch:
-        return x != 0 ? "true" : "false";
+        case Kind::Integer:
+            return std::to_string((long long)x);
+        case Kind::Real:
+            return number_text(x);
+        case Kind::Choice:
+            return choices[size_t(x)];
+        case Kind::Switch:
+            return x != 0 ? "true" : "false";
     }
     return "";
 }
@@ -238,37 +239,37 @@ void apply_setting(SolverSettings& s, const OptionSpec& option, const std::strin
                    const std::string& what, const std::string& file, int line_number) {
     const Line line{file, line_number, {}};
     switch (option.kind) {
-    case Kind::Integer:
-        option.set(s, double(parse_integer(line, value, what, (long long)option.lo,
-                                           (long long)option.hi)));
-        return;
-    case Kind::Real: {
-        const double x = parse_double(line, value, what);
-        if (x < option.lo || x > option.hi || (option.open_lo && x == option.lo) ||
-            (option.open_hi && x == option.hi))
-            line.fail(what + " " + fmt(x) + " is outside " + (option.open_lo ? "(" : "[") +
-                      fmt(option.lo) + ", " + fmt(option.hi) + (option.open_hi ? ")" : "]"));
-        option.set(s, x);
-        return;
-    }
-    case Kind::Choice: {
-        const auto it = std::find(option.choices.begin(), option.choices.end(), value);
-        if (it == option.choices.end())
-            line.fail(what + " " + in_quotes(value) + " " + not_a_choice(option.choices));
-        option.set(s, double(it - option.choices.begin()));
-        return;
-    }
-    case Kind::Switch:
-        // DESIGN: one switch, two spellings: scene files wrote true|false, flags on|off.
-        if (value == "true" || value == "on") {
-            option.set(s, 1);
-        } else if (value == "false" || value == "off") {
-            option.set(s, 0);
-        } else {
-            line.fail(what + " " + in_quotes(value) +
-                      " is neither 'true' nor 'false' (or 'on', 'off')");
+        case Kind::Integer:
+            option.set(s, double(parse_integer(line, value, what, (long long)option.lo,
+                                               (long long)option.hi)));
+            return;
+        case Kind::Real: {
+            const double x = parse_double(line, value, what);
+            if (x < option.lo || x > option.hi || (option.open_lo && x == option.lo) ||
+                (option.open_hi && x == option.hi))
+                line.fail(what + " " + fmt(x) + " is outside " + (option.open_lo ? "(" : "[") +
+                          fmt(option.lo) + ", " + fmt(option.hi) + (option.open_hi ? ")" : "]"));
+            option.set(s, x);
+            return;
         }
-        return;
+        case Kind::Choice: {
+            const auto it = std::find(option.choices.begin(), option.choices.end(), value);
+            if (it == option.choices.end())
+                line.fail(what + " " + in_quotes(value) + " " + not_a_choice(option.choices));
+            option.set(s, double(it - option.choices.begin()));
+            return;
+        }
+        case Kind::Switch:
+            // DESIGN: one switch, two spellings: scene files wrote true|false, flags on|off.
+            if (value == "true" || value == "on") {
+                option.set(s, 1);
+            } else if (value == "false" || value == "off") {
+                option.set(s, 0);
+            } else {
+                line.fail(what + " " + in_quotes(value) +
+                          " is neither 'true' nor 'false' (or 'on', 'off')");
+            }
+            return;
     }
 }
 

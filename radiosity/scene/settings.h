@@ -39,26 +39,26 @@ enum class ContactOracleSetting {
 /// The settings of the progressive loop (section 4) and of one transfer (section 5). The
 /// initial values are the defaults; option_table() describes each field.
 struct SolverSettings {
-    int order = 4;                    // B-spline order m (degree m - 1); the paper uses 4 and 3
-    int min_depth = 1;                // oracle quadtree bounds; min = max = d is uniform
-    int max_depth = 6;                //   (d = subdivisions below the root: leaves 2^-d wide)
-    double oracle_tolerance = 1e-3;   // relative agreement of the two Gauss-Legendre rules
-    double truncation_eps = 1e-6;     // relative cut-off of |DN x DN| (rhombus, Figure 3)
-    double rhombus_radius = 0;        // in cells; 0: derived from truncation_eps
+    int order = 4;                   // B-spline order m (degree m - 1); the paper uses 4 and 3
+    int min_depth = 1;               // oracle quadtree bounds; min = max = d is uniform
+    int max_depth = 6;               //   (d = subdivisions below the root: leaves 2^-d wide)
+    double oracle_tolerance = 1e-3;  // relative agreement of the two Gauss-Legendre rules
+    double truncation_eps = 1e-6;    // relative cut-off of |DN x DN| (rhombus, Figure 3)
+    double rhombus_radius = 0;       // in cells; 0: derived from truncation_eps
     ExtrapolationSetting extrapolation = ExtrapolationSetting::Linear;
-    int shadow_rays = 4;              // rays per fulcrum per shooter patch, eq. (28)
-    int max_shots = 100;              // cap on progressive shots
-    double convergence = 1e-3;        // stop when the largest unshot power < this x emitted
-    bool self_transfer = false;       // may a concave curved surface light itself
-    int tessellation = 16;            // facets per parameter direction for ray casting
+    int shadow_rays = 4;         // rays per fulcrum per shooter patch, eq. (28)
+    int max_shots = 100;         // cap on progressive shots
+    double convergence = 1e-3;   // stop when the largest unshot power < this x emitted
+    bool self_transfer = false;  // may a concave curved surface light itself
+    int tessellation = 16;       // facets per parameter direction for ray casting
     ShadowSetting shadows = ShadowSetting::Exact;
-    double tolerance = 2e-3;          // accuracy relative to the scene's radiosity scale
+    double tolerance = 2e-3;  // accuracy relative to the scene's radiosity scale
     UnifySetting unify = UnifySetting::Projection;
-    bool ambient = true;              // ambient correction of the unshot power at the end
-    bool hidden = true;               // hidden regions take their visible neighbours' values
-    int shooter_level = 3;            // a shooter's unshot field coarsened to at most this level
-    int contact_depth = 2;            // receiver cells touching a planar shooter split to at
-                                      //   least this level (0: off)
+    bool ambient = true;    // ambient correction of the unshot power at the end
+    bool hidden = true;     // hidden regions take their visible neighbours' values
+    int shooter_level = 3;  // a shooter's unshot field coarsened to at most this level
+    int contact_depth = 2;  // receiver cells touching a planar shooter split to at
+                            //   least this level (0: off)
     ContactOracleSetting contact_oracle = ContactOracleSetting::Means;
 };
 
@@ -73,11 +73,11 @@ struct OptionSpec {
     std::string name;                  // `set NAME VALUE`; the flag is --NAME with '-' for '_'
     std::vector<std::string> aliases;  // further flags accepted (the older spellings)
     Kind kind = Kind::Integer;
-    double lo = 0, hi = 0;             // Integer and Real: the range
+    double lo = 0, hi = 0;                  // Integer and Real: the range
     bool open_lo = false, open_hi = false;  // Real: the range excludes lo, hi
-    std::vector<std::string> choices;  // Choice: the words
-    std::string unit;                  // placeholder in the usage text ("m", "d", "x", ...)
-    std::string doc;                   // one line: what it means
+    std::vector<std::string> choices;       // Choice: the words
+    std::string unit;                       // placeholder in the usage text ("m", "d", "x", ...)
+    std::string doc;                        // one line: what it means
     /// Writes a parsed value into the settings: Integer and Real the number, Choice the index
     /// of the word, Switch 1 or 0.
     std::function<void(SolverSettings&, double)> set;

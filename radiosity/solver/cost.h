@@ -6,9 +6,9 @@
 
 #include <string>
 
-#include "radiosity/transfer/transfer.h"
 #include "radiosity/scene/scene.h"
 #include "radiosity/solver/solver.h"
+#include "radiosity/transfer/transfer.h"
 
 namespace mbr {
 

@@ -245,7 +245,8 @@ ProgressiveSolver::ProgressiveSolver(const Scene& scene, const Octree& octree,
     weights_.resize(n);
     hidden_.resize(n);
     if (options.hidden_regions)
-        for (int i = 0; i < n; ++i) hidden_[i] = find_hidden(scene.surfaces[i].surface, i, octree, options.hidden);
+        for (int i = 0; i < n; ++i)
+            hidden_[i] = find_hidden(scene.surfaces[i].surface, i, octree, options.hidden);
     // "for each emitting surface L_i compute the projection of its emittance distribution".
     double emitted = 0;
     Rgb emitted_rgb;
@@ -386,9 +387,8 @@ std::vector<ProgressiveSolver::Received> ProgressiveSolver::transfer_to(
     return results;
 }
 
-void ProgressiveSolver::superpose(const std::vector<int>& receivers,
-                                  std::vector<Received>& results, int h, const Shooter& shooter,
-                                  ShotStats& shot) {
+void ProgressiveSolver::superpose(const std::vector<int>& receivers, std::vector<Received>& results,
+                                  int h, const Shooter& shooter, ShotStats& shot) {
     const int n = static_cast<int>(scene_.surfaces.size());
     const int n_rec = static_cast<int>(receivers.size());
     const Rgb shot_power = power(h, shooter.unshot);

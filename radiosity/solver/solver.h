@@ -1,10 +1,11 @@
-// radiosity/solver/solver.h - the radiosity of a whole scene by progressive refinement (paper section 4,
-// the algorithm box, and section 5 "Iteration"; DESIGN.md section 4).
+// radiosity/solver/solver.h - the radiosity of a whole scene by progressive refinement (paper
+// section 4, the algorithm box, and section 5 "Iteration"; DESIGN.md section 4).
 //
 //   for each emitting surface: project its emission; B = dB_unshot = E
 //   while not converged:
 //     shoot from the surface with the largest unshot power  int B_unshot A
-//     every surface that can receive from it gets dB by one transfer (radiosity/transfer/transfer.h),
+//     every surface that can receive from it gets dB by one transfer
+//     (radiosity/transfer/transfer.h),
 //       with shadows; B += dB, B_unshot += dB (SplineField::add)
 //     B_unshot of the shooter = 0
 //
@@ -21,40 +22,40 @@
 #include <vector>
 
 #include "octree/octree.h"
-#include "radiosity/visibility/hidden_regions.h"
 #include "radiosity/geometry/quadtree.h"
-#include "radiosity/transfer/transfer.h"
-#include "radiosity/scene/scene.h"
 #include "radiosity/geometry/spline_field.h"
+#include "radiosity/scene/scene.h"
+#include "radiosity/transfer/transfer.h"
+#include "radiosity/visibility/hidden_regions.h"
 
 namespace mbr {
 
 /// Options of the progressive loop and of its transfers.
 struct SolverOptions {
-    ReceiverOptions receiver;       // every transfer's options (order, depths, shadows, ...)
-    int max_shots = 100;            // stop after this many shots
-    double convergence = 1e-3;      // stop when the largest unshot power < this x emitted
-    bool self_transfer = false;     // concave curved surfaces receive from themselves
-    double tolerance = 2e-3;        // accuracy relative to the scene's radiosity scale: the
-                                    //   absolute tolerance of every transfer (see file comment)
+    ReceiverOptions receiver;    // every transfer's options (order, depths, shadows, ...)
+    int max_shots = 100;         // stop after this many shots
+    double convergence = 1e-3;   // stop when the largest unshot power < this x emitted
+    bool self_transfer = false;  // concave curved surfaces receive from themselves
+    double tolerance = 2e-3;     // accuracy relative to the scene's radiosity scale: the
+                                 //   absolute tolerance of every transfer (see file comment)
     /// The quadrature's absolute tolerance, as a share of the transfer's (a constant).
     static constexpr double quadrature_share = 1;
     /// The level at which a textured emission is projected (a constant).
     static constexpr int emission_level = 5;
-    bool hidden_regions = true;     // beyond the paper: samples at points that see no front
-                                    //   face take the nearest visible point's value
-                                    //   (radiosity/visibility/hidden_regions.h)
-    HiddenOptions hidden;           // how hidden points are found
-    int shooter_level = 3;          // a shooter's unshot field is coarsened to at most this
-                                    //   level (the paper's "lower resolution version", section
-                                    //   6); the receiver options' shooter_coarsening levels at
-                                    //   least (levels 4 and 5 measured: docs/method.md)
-    bool ambient = true;            // beyond the paper: at the end, the power still unshot is
-                                    //   sent on through the measured coupling of the surfaces
-                                    //   (the fraction of each shooter's power each receiver got,
-                                    //   over all its shots) and added as a constant radiosity per
-                                    //   surface (Cohen et al. 1988's ambient term, with measured
-                                    //   instead of area-weighted coupling)
+    bool hidden_regions = true;  // beyond the paper: samples at points that see no front
+                                 //   face take the nearest visible point's value
+                                 //   (radiosity/visibility/hidden_regions.h)
+    HiddenOptions hidden;        // how hidden points are found
+    int shooter_level = 3;       // a shooter's unshot field is coarsened to at most this
+                                 //   level (the paper's "lower resolution version", section
+                                 //   6); the receiver options' shooter_coarsening levels at
+                                 //   least (levels 4 and 5 measured: docs/method.md)
+    bool ambient = true;         // beyond the paper: at the end, the power still unshot is
+                                 //   sent on through the measured coupling of the surfaces
+                                 //   (the fraction of each shooter's power each receiver got,
+                                 //   over all its shots) and added as a constant radiosity per
+                                 //   surface (Cohen et al. 1988's ambient term, with measured
+                                 //   instead of area-weighted coupling)
 };
 
 /// The scene's `set` statements as solver options (shadows: the scene's method and rays).
@@ -97,7 +98,7 @@ struct SolveStats {
     long peak_memory_bytes = 0;  // the process's peak resident memory
     long coefficients = 0;       // coefficients of the solved fields (all surfaces, per channel)
     long kernel_evals = 0, rays = 0;
-    double ambient_power = 0;     // power the ambient correction added (sum of channels)
+    double ambient_power = 0;  // power the ambient correction added (sum of channels)
     std::vector<ShotStats> per_shot;
 };
 
@@ -149,7 +150,7 @@ private:
     /// Power weights w_kl = int int N_k N_l A per surface and level (cached).
     const std::vector<double>& power_weights(int surface, int level) const;
     mutable std::vector<std::vector<std::vector<double>>> weights_;
-    std::vector<HiddenMask> hidden_;  // per surface (empty masks when the option is off)
+    std::vector<HiddenMask> hidden_;    // per surface (empty masks when the option is off)
     std::vector<double> last_seconds_;  // per surface: its last transfer's seconds (scheduling)
     Rgb power(int surface, const SplineField& field) const;
 

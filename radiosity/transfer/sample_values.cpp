@@ -12,7 +12,8 @@ namespace mbr {
 namespace {
 /// A dyadic cell of the shooter as one integer: level (5 bits), i and j (28 bits each).
 std::uint64_t cell_key(const QuadCell& cell) {
-    return (std::uint64_t(cell.level) << 56) | (std::uint64_t(cell.i) << 28) | std::uint64_t(cell.j);
+    return (std::uint64_t(cell.level) << 56) | (std::uint64_t(cell.i) << 28) |
+           std::uint64_t(cell.j);
 }
 }  // namespace
 
@@ -51,13 +52,15 @@ double IncrementIntegrator::visible_form_factor(const SurfacePoint& p) {
     };
     if (!options_.shadow_subtraction) {  // the visible pieces themselves
         double F = 0;
-        for (const ConvexPolygon& piece : visible_pieces(plane_.outline, view_)) F += lambert(piece);
+        for (const ConvexPolygon& piece : visible_pieces(plane_.outline, view_))
+            F += lambert(piece);
         return F;
     }
     // The front part of the outline minus the disjoint parts of the shadows: two or three
     // polygons instead of the pieces the shadows would cut the outline into.
     take_shadows_apart();
-    const ConvexPolygon front = view_.horizon_cuts ? clip(plane_.outline, view_.front) : plane_.outline;
+    const ConvexPolygon front =
+        view_.horizon_cuts ? clip(plane_.outline, view_.front) : plane_.outline;
     double hidden_area = 0;
     for (const ConvexPolygon& region : shadow_regions_) hidden_area += signed_area(region);
     // An umbra: the shadows cover all of it (the regions are disjoint parts of it), exactly 0.
@@ -135,7 +138,8 @@ Rgb IncrementIntegrator::triangle_value(const SurfacePoint& p, Vec2 a, Vec2 b, V
     for (size_t q = 0; q < rule.points.size(); ++q) {
         const double xi = rule.points[q].x, eta = rule.points[q].y;
         const Vec2 X = a + xi * (b - a) + eta * (c - a);
-        const double F = form_factor_kernel(p.position, p.normal, plane_.to_space(X), plane_.normal);
+        const double F =
+            form_factor_kernel(p.position, p.normal, plane_.to_space(X), plane_.normal);
         ++extra_evaluations_;
         if (F == 0) continue;
         Rgb B = constant_b;
@@ -165,7 +169,7 @@ Rgb IncrementIntegrator::shadow_integral(const SurfacePoint& p, double tolerance
         const Vec2 w = t.bary[k];  // weights of b and c
         return a + w.x * (b - a) + w.y * (c - a);
     };
-    auto too_near = [&](const Vec2 (&v)[3]) {
+    auto too_near = [&](const Vec2(&v)[3]) {
         if (near_field <= 0) return false;
         Box3 box;
         for (const Vec2& q : v) box.extend(plane_.to_space(q));
@@ -222,16 +226,19 @@ Rgb IncrementIntegrator::shadow_integral(const SurfacePoint& p, double tolerance
     return sum;
 }
 
-Rgb IncrementIntegrator::shadow_on(const SurfacePoint& p, const std::vector<ShadowTriangle>& triangles) {
+Rgb IncrementIntegrator::shadow_on(const SurfacePoint& p,
+                                   const std::vector<ShadowTriangle>& triangles) {
     Rgb sum;
     for (const ShadowTriangle& t : triangles) {
-        if (t.region >= int(shadow_regions_.size()) || t.fan + 1 >= int(shadow_regions_[t.region].size()))
+        if (t.region >= int(shadow_regions_.size()) ||
+            t.fan + 1 >= int(shadow_regions_[t.region].size()))
             continue;  // the shadow's outline changed between the two points: part not found
         const ConvexPolygon& piece = shadow_regions_[t.region];
         const Vec2 a = piece[0], b = piece[t.fan], c = piece[t.fan + 1];
         Vec2 v[3];
         for (int k = 0; k < 3; ++k) v[k] = a + t.bary[k].x * (b - a) + t.bary[k].y * (c - a);
-        sum += triangle_value(p, v[0], v[1], v[2], (options_.n_pieces > 0 ? options_.n_pieces : options_.n) + 1);
+        sum += triangle_value(p, v[0], v[1], v[2],
+                              (options_.n_pieces > 0 ? options_.n_pieces : options_.n) + 1);
     }
     return sum;
 }
@@ -255,7 +262,8 @@ void IncrementIntegrator::take_shadows_apart() {
     // (the kernel-evaluation counts of some shots differ between units); with 1e-10 none does.
     const double min_offset = 1e-10 * plane_.size;
     for (size_t s = 0; s < view_.shadows.size(); ++s) {
-        std::vector<ConvexPolygon> parts{view_.horizon_cuts ? clip(view_.shadows[s], view_.front) : view_.shadows[s]};
+        std::vector<ConvexPolygon> parts{view_.horizon_cuts ? clip(view_.shadows[s], view_.front)
+                                                            : view_.shadows[s]};
         for (size_t t = 0; t < s && !parts.empty(); ++t) {
             std::vector<ConvexPolygon> next;
             for (const ConvexPolygon& part : parts)
@@ -295,11 +303,12 @@ ConvexPolygon IncrementIntegrator::cell_image(const QuadCell& cell) const {
     // Iso-parameter lines of a bilinear map are straight: a cell's image is the quadrilateral of
     // its corners (counter-clockwise, as the whole quad's).
     const Rect& r = cell.rect;
-    return {plane_.at(r.x0, r.y0), plane_.at(r.x1, r.y0), plane_.at(r.x1, r.y1), plane_.at(r.x0, r.y1)};
+    return {plane_.at(r.x0, r.y0), plane_.at(r.x1, r.y0), plane_.at(r.x1, r.y1),
+            plane_.at(r.x0, r.y1)};
 }
 
-Rgb IncrementIntegrator::pieces_value(const SurfacePoint& p, const std::vector<ConvexPolygon>& pieces,
-                                      int n) {
+Rgb IncrementIntegrator::pieces_value(const SurfacePoint& p,
+                                      const std::vector<ConvexPolygon>& pieces, int n) {
     // The n x n collapsed Gauss rule on a fan of triangles of each convex piece, in the shooter's
     // plane: int F(p, x) B_h(u(x), v(x)) dA(x) (dA is the plane's own area element, so the area
     // factor A_h of the parameter map does not appear).
@@ -315,7 +324,8 @@ Rgb IncrementIntegrator::pieces_value(const SurfacePoint& p, const std::vector<C
             if (jacobian <= 0) continue;
             for (size_t q = 0; q < rule.points.size(); ++q) {
                 const Vec2 X = a + rule.points[q].x * (b - a) + rule.points[q].y * (c - a);
-                const double F = form_factor_kernel(p.position, p.normal, plane_.to_space(X), plane_.normal);
+                const double F =
+                    form_factor_kernel(p.position, p.normal, plane_.to_space(X), plane_.normal);
                 ++extra_evaluations_;
                 if (F == 0) continue;
                 Rgb B = constant_b;
@@ -337,7 +347,8 @@ IncrementIntegrator::PointSpan IncrementIntegrator::horizon_points(const QuadCel
     const std::uint64_t key = (cell_key(cell) << 1) | std::uint64_t(n == options_.n ? 0 : 1);
     auto it = horizon_cache_.find(key);
     if (it == horizon_cache_.end()) {
-        if (horizon_cache_.size() > 200000) horizon_cache_.clear();  // bound it; values never depend on it
+        if (horizon_cache_.size() > 200000)
+            horizon_cache_.clear();  // bound it; values never depend on it
         std::vector<ShooterPoint> pts;
         ConvexPolygon piece = clip(image, view_.front);
         // A horizon through a corner of the cell leaves a near-repeated vertex where rounding
@@ -374,15 +385,18 @@ Rgb IncrementIntegrator::cell_value(const SurfacePoint& p, const QuadCell& cell,
         const ConvexPolygon image = cell_image(cell);
         bool shadowed = false;
         switch (classify_cell(image, view_, &shadowed)) {
-            case CellVisibility::hidden: return Rgb{};
-            case CellVisibility::clear: return sum_over(p, points(cell, n));
+            case CellVisibility::hidden:
+                return Rgb{};
+            case CellVisibility::clear:
+                return sum_over(p, points(cell, n));
             case CellVisibility::cut: {
                 const std::uint64_t key = cell_key(cell);
                 if (cell.level < min_cut_level && cell.level < options_.max_depth) {
                     mixed_.push_back(key);  // split without integrating its pieces
                     return Rgb{};
                 }
-                if (!shadowed && receiver_plane_) return sum_over(p, horizon_points(cell, n, image));
+                if (!shadowed && receiver_plane_)
+                    return sum_over(p, horizon_points(cell, n, image));
                 if (key != pieces_key_) {  // the n and n+1 rules of one cell share the pieces
                     pieces_ = visible_pieces(image, view_);
                     pieces_key_ = key;
@@ -412,7 +426,8 @@ Rgb IncrementIntegrator::cell_value(const SurfacePoint& p, const QuadCell& cell,
         const Plane& pl = poly.plane();
         double lo = HUGE_VAL, hi = -HUGE_VAL;
         for (int corner = 0; corner < 8; ++corner) {
-            const Vec3 c{(corner & 1) ? shaft.hi.x : shaft.lo.x, (corner & 2) ? shaft.hi.y : shaft.lo.y,
+            const Vec3 c{(corner & 1) ? shaft.hi.x : shaft.lo.x,
+                         (corner & 2) ? shaft.hi.y : shaft.lo.y,
                          (corner & 4) ? shaft.hi.z : shaft.lo.z};
             const double d = pl.signed_distance(c);
             lo = std::min(lo, d);
@@ -475,7 +490,8 @@ IncrementIntegrator::Result IncrementIntegrator::integrate(const SurfacePoint& p
     Rgb exact_part;
     if (planar_ && !unshot_constant_ && options_.subtract && allow_subtraction && !view_.use_rays) {
         const Vec2 uv = plane_.parameters(plane_.to_plane(p.position));
-        const Rgb b_star = shooter_.unshot.evaluate(std::clamp(uv.x, 0.0, 1.0), std::clamp(uv.y, 0.0, 1.0));
+        const Rgb b_star =
+            shooter_.unshot.evaluate(std::clamp(uv.x, 0.0, 1.0), std::clamp(uv.y, 0.0, 1.0));
         exact_part = visible_form_factor(p) * b_star;
         b_star_ = b_star;
         result.subtracted = b_star;
@@ -518,7 +534,8 @@ IncrementIntegrator::Result IncrementIntegrator::integrate(const SurfacePoint& p
     // the shooter sees. A cell is trusted only when it is well separated from p: its points'
     // extent at most near_field times their distance from p.
     auto near = [&](const QuadCell& cell) {
-        if (!mixed_.empty() && std::find(mixed_.begin(), mixed_.end(), cell_key(cell)) != mixed_.end() &&
+        if (!mixed_.empty() &&
+            std::find(mixed_.begin(), mixed_.end(), cell_key(cell)) != mixed_.end() &&
             (!ray_visibility || cell.level < options_.max_visibility_depth))
             return true;  // its nodes disagree on visibility, or a coarse cut cell: split
         if (near_field <= 0) return false;
@@ -528,7 +545,8 @@ IncrementIntegrator::Result IncrementIntegrator::integrate(const SurfacePoint& p
         Box3 box;
         for (int i = 0; i < pts.count; ++i) box.extend(pts.first[i].x);
         const Rect& r = cell.rect;
-        for (const Vec2 c : {Vec2{r.x0, r.y0}, Vec2{r.x1, r.y0}, Vec2{r.x0, r.y1}, Vec2{r.x1, r.y1}})
+        for (const Vec2 c :
+             {Vec2{r.x0, r.y0}, Vec2{r.x1, r.y0}, Vec2{r.x0, r.y1}, Vec2{r.x1, r.y1}})
             box.extend(shooter_.surface->point(c.x, c.y));
         const Vec3 gap = max(max(box.lo - p.position, p.position - box.hi), Vec3{0, 0, 0});
         return length(box.extent()) > near_field * length(gap);
@@ -536,7 +554,8 @@ IncrementIntegrator::Result IncrementIntegrator::integrate(const SurfacePoint& p
     auto r = adaptive_tensor_rule_2d(cell_rule, root.rect, opt, keep_partition, near);
     result.value = r.value + exact_part - shadowed;
     if (!keep_partition) result.shadow_triangles.clear();
-    result.n_evaluations = r.n_evaluations + long(options_.n + 1) * (options_.n + 1) + extra_evaluations_;
+    result.n_evaluations =
+        r.n_evaluations + long(options_.n + 1) * (options_.n + 1) + extra_evaluations_;
     result.n_rays = rays_;
     result.converged = r.converged;
     result.partition = std::move(r.cells);
@@ -564,13 +583,14 @@ Rgb IncrementIntegrator::integrate_on(const SurfacePoint& p,
         if (shape == made_by->shadow_shape)
             sum -= shadow_on(p, made_by->shadow_triangles);
         else if (!shadow_regions_.empty())
-            sum -= shadow_integral(p, made_by->shadow_tolerance, made_by->shadow_near_field,
-                                   nullptr);
+            sum -=
+                shadow_integral(p, made_by->shadow_tolerance, made_by->shadow_near_field, nullptr);
     }
     if (!view_.behind_all)
         for (const auto& c : partition) sum += cell_value(p, c.cell, options_.n + 1);
     if (n_evaluations)
-        *n_evaluations += long(partition.size()) * (options_.n + 1) * (options_.n + 1) + extra_evaluations_;
+        *n_evaluations +=
+            long(partition.size()) * (options_.n + 1) * (options_.n + 1) + extra_evaluations_;
     if (n_rays) *n_rays += rays_;
     return sum;
 }

@@ -48,32 +48,32 @@ struct QuadratureOptions {
                                   //   shot's partitions stay coarse
     int max_depth = 24;           // cap on the shooter's subdivision (at most 28)
     int min_depth = 1;            // the whole shooter is never accepted as one cell
-    double min_share = 1e-6;      // floor of a cell's share of the tolerance (math/gauss_legendre.h)
-    bool global = false;          // refine the worst cell first until the error estimates sum
-                                  //   to the tolerance (AdaptiveOptions::global), instead of
-                                  //   the paper's quarter tolerance per child
-    bool analytic = true;         // a planar quad shooter of constant radiosity (an emitter's
-                                  //   first shot): I(p) by the contour formula over the
-                                  //   visible pieces, no quadrature (not when a partition is
-                                  //   asked for)
+    double min_share = 1e-6;  // floor of a cell's share of the tolerance (math/gauss_legendre.h)
+    bool global = false;      // refine the worst cell first until the error estimates sum
+                              //   to the tolerance (AdaptiveOptions::global), instead of
+                              //   the paper's quarter tolerance per child
+    bool analytic = true;     // a planar quad shooter of constant radiosity (an emitter's
+                              //   first shot): I(p) by the contour formula over the
+                              //   visible pieces, no quadrature (not when a partition is
+                              //   asked for)
     bool shadow_subtraction = true;  // planar shooters with occluders: the cells see only the
-                                  //   horizon, and the shadowed part (the union of the shadows
-                                  //   in front) is integrated on its own and subtracted; else
-                                  //   each cut cell's visible pieces are integrated
-    int n_pieces = 0;             // the rule pair on cut cells' pieces: n_pieces against
-                                  //   n_pieces + 1 points per triangle side (0: n, as cells)
-    bool subtract = true;         // planar quad shooters of varying radiosity: I(p) =
-                                  //   B_h(x*) F(p -> visible part) + int F (B_h - B_h(x*)),
-                                  //   the first term by the contour formula (x* the foot of p
-                                  //   on the shooter), so the peak of F near a receiving point
-                                  //   close to the shooter (surfaces that meet) is exact and the
-                                  //   remainder is nearly flat there
-    bool clip_horizon = true;     // planar shooters: integrate cells the receiving point's
-                                  //   tangent plane cuts over their front part only (exact
-                                  //   convex pieces), instead of chasing the kink of the
-                                  //   clamped cosine of (3) down to max_depth
-    int max_visibility_depth = 10;  // exact visibility on a curved shooter: cells whose nodes
-                                  //   disagree on visibility are split down to this level
+                                     //   horizon, and the shadowed part (the union of the shadows
+                                     //   in front) is integrated on its own and subtracted; else
+                                     //   each cut cell's visible pieces are integrated
+    int n_pieces = 0;                // the rule pair on cut cells' pieces: n_pieces against
+                                     //   n_pieces + 1 points per triangle side (0: n, as cells)
+    bool subtract = true;            // planar quad shooters of varying radiosity: I(p) =
+                                     //   B_h(x*) F(p -> visible part) + int F (B_h - B_h(x*)),
+                                     //   the first term by the contour formula (x* the foot of p
+                                     //   on the shooter), so the peak of F near a receiving point
+                                     //   close to the shooter (surfaces that meet) is exact and the
+                                     //   remainder is nearly flat there
+    bool clip_horizon = true;        // planar shooters: integrate cells the receiving point's
+                                     //   tangent plane cuts over their front part only (exact
+                                     //   convex pieces), instead of chasing the kink of the
+                                     //   clamped cosine of (3) down to max_depth
+    int max_visibility_depth = 10;   // exact visibility on a curved shooter: cells whose nodes
+                                     //   disagree on visibility are split down to this level
 };
 
 /// One shooter point of the quadrature with everything that does not depend on the receiver:
@@ -95,7 +95,8 @@ struct ShadowTriangle {
     int level = 0;
     /// The four triangles of its edges' midpoints.
     std::array<ShadowTriangle, 4> children() const {
-        const Vec2 ab = 0.5 * (bary[0] + bary[1]), bc = 0.5 * (bary[1] + bary[2]), ca = 0.5 * (bary[2] + bary[0]);
+        const Vec2 ab = 0.5 * (bary[0] + bary[1]), bc = 0.5 * (bary[1] + bary[2]),
+                   ca = 0.5 * (bary[2] + bary[0]);
         return {ShadowTriangle{region, fan, {bary[0], ab, ca}, level + 1},
                 ShadowTriangle{region, fan, {ab, bary[1], bc}, level + 1},
                 ShadowTriangle{region, fan, {ca, bc, bary[2]}, level + 1},
@@ -117,8 +118,8 @@ struct ShadowTriangle {
 ///   I(p) = int_{[0,1]^2} F(p, x_h(u,v)) VIS B_h(u,v) A_h(u,v) du dv,
 /// by the adaptive rule of section 6 (n against n + 1 points per cell, split in four with a
 /// quarter of the tolerance). VIS = 1 unless an occlusion context is given (exact visibility,
-/// radiosity/visibility/visible_parts.h): then a planar shooter's cells are clipped to what p sees, and a curved
-/// shooter's nodes each cast a ray. Shooter points are cached per dyadic cell, so one
+/// radiosity/visibility/visible_parts.h): then a planar shooter's cells are clipped to what p sees,
+/// and a curved shooter's nodes each cast a ray. Shooter points are cached per dyadic cell, so one
 /// integrator per thread: the cache changes speed, never values, so results do not depend on
 /// thread count.
 class IncrementIntegrator {
@@ -128,10 +129,10 @@ public:
 
     struct Result {
         Rgb value;
-        long n_evaluations = 0;   // kernel evaluations
-        long n_rays = 0;          // visibility rays (exact visibility on a curved shooter)
-        Rgb subtracted;           // B_h(x*) when the singularity was subtracted (the partition's
-                                  //   cell values are then those of the remainder)
+        long n_evaluations = 0;  // kernel evaluations
+        long n_rays = 0;         // visibility rays (exact visibility on a curved shooter)
+        Rgb subtracted;          // B_h(x*) when the singularity was subtracted (the partition's
+                                 //   cell values are then those of the remainder)
         bool shadow_subtracted = false;  // the shadowed part was integrated on its own
         std::vector<ShadowTriangle> shadow_triangles;  // its triangles (integrate_on reuses them)
         std::vector<int> shadow_shape;  // the vertex count of each shadow region they refer to
@@ -190,20 +191,20 @@ private:
     const Shooter& shooter_;
     QuadratureOptions options_;
     const OcclusionContext* occlusion_ = nullptr;  // exact visibility when set (and not clear)
-    bool planar_ = false;               // the shooter is a planar quad: exact clipping works
-    bool analytic_ = false;             // and of constant radiosity: closed form
-    ShooterPlane plane_;                // its frame
-    BlockedView view_;                  // what the current point cannot see
+    bool planar_ = false;                  // the shooter is a planar quad: exact clipping works
+    bool analytic_ = false;                // and of constant radiosity: closed form
+    ShooterPlane plane_;                   // its frame
+    BlockedView view_;                     // what the current point cannot see
     std::vector<TriangleRule> tri_rules_;  // tri_rules_[n]
-    long extra_evaluations_ = 0;        // kernel evaluations on cut pieces (current point)
-    long rays_ = 0;                     // rays cast for the current point
-    Rgb b_star_;                        // the constant subtracted from B_h (zero: none)
-    std::vector<int> local_;            // scratch: the occluders of one cell's shaft
-    std::vector<std::uint64_t> mixed_;  // cells whose nodes disagreed on visibility (curved), or
-                                        //   cut cells above min_cut_level (planar): split
-    std::uint64_t pieces_key_ = ~0ULL;  // the cut cell whose pieces are in pieces_
+    long extra_evaluations_ = 0;           // kernel evaluations on cut pieces (current point)
+    long rays_ = 0;                        // rays cast for the current point
+    Rgb b_star_;                           // the constant subtracted from B_h (zero: none)
+    std::vector<int> local_;               // scratch: the occluders of one cell's shaft
+    std::vector<std::uint64_t> mixed_;     // cells whose nodes disagreed on visibility (curved), or
+                                           //   cut cells above min_cut_level (planar): split
+    std::uint64_t pieces_key_ = ~0ULL;     // the cut cell whose pieces are in pieces_
     std::vector<ConvexPolygon> pieces_;
-    PolynomialPatches unshot_patches_;  // B_h for scattered points (cut pieces)
+    PolynomialPatches unshot_patches_;     // B_h for scattered points (cut pieces)
     std::optional<Plane> receiver_plane_;  // set_receiver_plane
     /// The front pieces' points of cells only the (fixed) horizon cuts, per cell and rule.
     std::unordered_map<std::uint64_t, std::vector<ShooterPoint>> horizon_cache_;
@@ -212,8 +213,8 @@ private:
     std::vector<ShooterPoint> pool_;    // every cached cell's points, one after the other
     std::vector<Rgb> unshot_values_;    // scratch: B_h on one cell's grid
     std::unordered_map<std::uint64_t, std::uint32_t> cache_;  // cell key -> offset in pool_
-    double unshot_bound_ = 0;           // max |B_h| bound: the largest coefficient
-    bool unshot_constant_ = false;      // B_h is one constant (an emitter's first shot)
+    double unshot_bound_ = 0;       // max |B_h| bound: the largest coefficient
+    bool unshot_constant_ = false;  // B_h is one constant (an emitter's first shot)
 };
 
 }  // namespace mbr

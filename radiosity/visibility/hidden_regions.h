@@ -1,7 +1,7 @@
-// radiosity/visibility/hidden_regions.h - the parts of a surface that see no front face of the scene: the floor
-// under a box resting on it, a ceiling behind a light hung a hair's breadth below it. No light
-// reaches them and nobody sees them, so their radiosity is zero from every shot, and the
-// projection (19) of samples that drop to zero across a footprint's edge rings into the visible
+// radiosity/visibility/hidden_regions.h - the parts of a surface that see no front face of the
+// scene: the floor under a box resting on it, a ceiling behind a light hung a hair's breadth below
+// it. No light reaches them and nobody sees them, so their radiosity is zero from every shot, and
+// the projection (19) of samples that drop to zero across a footprint's edge rings into the visible
 // part next to it (a C^2 spline cannot follow a step). Beyond the paper: a sample at a hidden
 // point takes the value of the nearest visible point instead, a continuous extension that the
 // splines follow (docs/method.md, "Hidden regions").

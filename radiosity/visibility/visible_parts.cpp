@@ -236,10 +236,12 @@ BlockedView blocked_view(const ShooterPlane& plane, Vec3 p, Vec3 n_p,
     // The horizon: the shooter's points x with n_p . (x - p) > 0 are in front of p (or, for a
     // point of a planar receiver, in front of the receiver's plane: the same line each time).
     if (receiver_plane)
-        view.front = HalfPlane{{dot(receiver_plane->normal, plane.e1), dot(receiver_plane->normal, plane.e2)},
-                               dot(receiver_plane->normal, plane.origin) - receiver_plane->offset};
+        view.front = HalfPlane{
+            {dot(receiver_plane->normal, plane.e1), dot(receiver_plane->normal, plane.e2)},
+            dot(receiver_plane->normal, plane.origin) - receiver_plane->offset};
     else
-        view.front = HalfPlane{{dot(n_p, plane.e1), dot(n_p, plane.e2)}, dot(n_p, plane.origin - p)};
+        view.front =
+            HalfPlane{{dot(n_p, plane.e1), dot(n_p, plane.e2)}, dot(n_p, plane.origin - p)};
     // DESIGN: a corner within rounding of the horizon line lies on it: within 1e-12 of the
     // magnitudes its value is computed from (the shooter's size and the planes' distances from
     // the origin), some 1e4 times their rounding. A shooter sharing an edge with the receiver

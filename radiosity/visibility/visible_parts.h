@@ -1,6 +1,6 @@
-// radiosity/visibility/visible_parts.h - visibility in one energy transfer (paper section 5, "Adaptive Subdivision
-// in Shadow Computation"; section 6, "Shadow" and "Octree"; eq. (28); DESIGN.md section 3,
-// stage 7).
+// radiosity/visibility/visible_parts.h - visibility in one energy transfer (paper section 5,
+// "Adaptive Subdivision in Shadow Computation"; section 6, "Shadow" and "Octree"; eq. (28);
+// DESIGN.md section 3, stage 7).
 //
 // Two methods, chosen by ShadowOptions::method (radiosity/transfer/receiver_state.h):
 //   Fractions (the paper's, the default): the transfer is computed without shadows; then, for
