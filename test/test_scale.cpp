@@ -445,8 +445,7 @@ TEST_CASE("scale: edgefill's divided differences under a shadow are the same in 
             make_occlusion_context(octree, scene.surfaces[size_t(wall)].surface, wall,
                                    scene.surfaces[size_t(ceiling)].surface, ceiling, 2);
         const Texture& rho = scene.material_of(ceiling).reflectance;
-        const HiddenMask mask = find_hidden(scene.surfaces[size_t(ceiling)].surface, ceiling,
-                                            octree, o.hidden);
+        const HiddenMask mask = find_hidden(scene.surfaces[size_t(ceiling)].surface, ceiling, octree);
         const ReceiverSurface receiver{&scene.surfaces[size_t(ceiling)].surface,
                                        [&rho](double s, double t) { return rho.value(s, t); },
                                        &mask};

@@ -230,7 +230,7 @@ TEST_CASE("solver: one bounce between two surfaces is the single transfer", "[so
     const int coarsen = std::max(ro.shooter_coarsening, E.level() - o.shooter_level);
     const Shooter shooter = make_shooter(scene.surfaces[0].surface, E, coarsen);
     const Texture& rho = scene.materials[1].reflectance;
-    const HiddenMask hidden = find_hidden(scene.surfaces[1].surface, 1, octree, o.hidden);
+    const HiddenMask hidden = find_hidden(scene.surfaces[1].surface, 1, octree);
     const ReceiverSurface receiver{&scene.surfaces[1].surface,
                                    [&rho](double s, double t) { return rho.value(s, t); },
                                    hidden.any() ? &hidden : nullptr};

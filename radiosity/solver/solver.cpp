@@ -246,7 +246,7 @@ ProgressiveSolver::ProgressiveSolver(const Scene& scene, const Octree& octree,
     hidden_.resize(n);
     if (options.hidden_regions)
         for (int i = 0; i < n; ++i)
-            hidden_[i] = find_hidden(scene.surfaces[i].surface, i, octree, options.hidden);
+            hidden_[i] = find_hidden(scene.surfaces[i].surface, i, octree);
     // "for each emitting surface L_i compute the projection of its emittance distribution".
     double emitted = 0;
     Rgb emitted_rgb;

@@ -45,7 +45,6 @@ struct SolverOptions {
     bool hidden_regions = true;  // beyond the paper: samples at points that see no front
                                  //   face take the nearest visible point's value
                                  //   (radiosity/visibility/hidden_regions.h)
-    HiddenOptions hidden;        // how hidden points are found
     int shooter_level = 3;       // a shooter's unshot field is coarsened to at most this
                                  //   level (the paper's "lower resolution version", section
                                  //   6); the receiver options' shooter_coarsening levels at

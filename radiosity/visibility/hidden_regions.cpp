@@ -65,10 +65,8 @@ Vec2 HiddenMask::substitute(double s, double t) const {
     return hidden_[k] ? substitute_[k] : Vec2{s, t};
 }
 
-HiddenMask find_hidden(const Surface& surface, int surface_id, const Octree& octree,
-                       const HiddenOptions& options) {
-    const int n = options.resolution;
-    MBR_CHECK(n >= 1 && options.rays >= 1);
+HiddenMask find_hidden(const Surface& surface, int surface_id, const Octree& octree) {
+    const int n = hidden_resolution;
     const Box3 box = octree.bounds();
     const double scale = box.empty() ? 1.0 : length(box.extent());
     std::vector<std::uint8_t> hidden(size_t(n) * n, 0);
@@ -86,7 +84,7 @@ HiddenMask find_hidden(const Surface& surface, int surface_id, const Octree& oct
         // meet the surface's own polygon at t = 0.
         const Vec3 origin = p.position + (1e-7 * scale) * nz;
         int back = 0, cast = 0;
-        for (int r = 0; r < options.rays; ++r) {
+        for (int r = 0; r < hidden_rays; ++r) {
             const double a = uniform01(key, 2 * r), b = uniform01(key, 2 * r + 1);
             const double phi = 2 * Pi * a, sin_theta = std::sqrt(b), cos_theta = std::sqrt(1 - b);
             const Vec3 dir = (sin_theta * std::cos(phi)) * nx + (sin_theta * std::sin(phi)) * ny +
@@ -98,7 +96,7 @@ HiddenMask find_hidden(const Surface& surface, int surface_id, const Octree& oct
             // Four rays first: a texel with a front face or an opening in sight is visible.
             if (r == 3 && back < 4) break;
         }
-        hidden[k] = cast == options.rays && back >= options.back_share * options.rays;
+        hidden[k] = cast == hidden_rays && back >= hidden_back_share * hidden_rays;
     });
     return HiddenMask(n, std::move(hidden));
 }

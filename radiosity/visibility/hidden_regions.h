@@ -41,19 +41,17 @@ private:
     std::vector<Vec2> substitute_;  // per texel (its own centre when visible)
 };
 
-/// Options of the hidden-region test.
-struct HiddenOptions {
-    int resolution = 64;      // texels along each parameter direction
-    int rays = 16;            // cosine-distributed rays per texel centre
-    double back_share = 0.9;  // hidden when at least this share of the rays hit a back face
-};
+/// The hidden-region test's constants.
+constexpr int hidden_resolution = 64;      // texels along each parameter direction
+constexpr int hidden_rays = 16;            // cosine-distributed rays per texel centre
+constexpr double hidden_back_share = 0.9;  // hidden when at least this share of the rays hit a
+                                           //   back face
 
 /// The mask of `surface` (its index in the octree's polygons' surface ids is `surface_id`):
 /// from each texel centre, rays over the hemisphere in front; a ray that meets a polygon's
 /// back before anything else counts as hidden, one that meets a front face or leaves the scene
 /// as visible. A texel is tested with 4 rays first and the rest only when all 4 were hidden.
 /// Rays are seeded from the surface and the texel (reproducible, thread-count independent).
-HiddenMask find_hidden(const Surface& surface, int surface_id, const Octree& octree,
-                       const HiddenOptions& options = {});
+HiddenMask find_hidden(const Surface& surface, int surface_id, const Octree& octree);
 
 }  // namespace mbr
