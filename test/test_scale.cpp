@@ -391,7 +391,8 @@ TEST_CASE("scale: a whole-scene solve gives the same radiosity in any unit", "[s
     }
 }
 
-TEST_CASE("scale: the Cornell box in millimetres and in metres has the same radiosity", "[scale]") {
+TEST_CASE("scale: the Cornell box in millimetres and in metres has the same radiosity",
+          "[scale][slow]") {
     // Measured as above: x 2^-10 (units of 1.024 m) bitwise the same; x 1e-3 (metres) 3.9e-14
     // of the largest value, 7.6e-13 pointwise; x 1e-6 (kilometres) alike.
     const Solution mm = quick_solve(cornell_box_scaled(1), 3);
@@ -445,7 +446,8 @@ TEST_CASE("scale: edgefill's divided differences under a shadow are the same in 
             make_occlusion_context(octree, scene.surfaces[size_t(wall)].surface, wall,
                                    scene.surfaces[size_t(ceiling)].surface, ceiling, 2);
         const Texture& rho = scene.material_of(ceiling).reflectance;
-        const HiddenMask mask = find_hidden(scene.surfaces[size_t(ceiling)].surface, ceiling, octree);
+        const HiddenMask mask =
+            find_hidden(scene.surfaces[size_t(ceiling)].surface, ceiling, octree);
         const ReceiverSurface receiver{&scene.surfaces[size_t(ceiling)].surface,
                                        [&rho](double s, double t) { return rho.value(s, t); },
                                        &mask};

@@ -386,7 +386,7 @@ TEST_CASE("solver: damaged, truncated and foreign solution files are refused", "
     }
 }
 
-TEST_CASE("solver: a surface solved at depth 8 shoots", "[solver]") {
+TEST_CASE("solver: a surface solved at depth 8 shoots", "[solver][slow]") {
     // A small floor under a small light, the receivers' trees forced to depth 8 everywhere;
     // then the floor, holding a level-8 field, shoots to a panel above the light's plane (which
     // the light cannot reach, so that only the floor receives in the first shot). The floor's
@@ -405,7 +405,7 @@ TEST_CASE("solver: a surface solved at depth 8 shoots", "[solver]") {
         o.receiver.min_depth = 8;
         o.receiver.max_depth = 8;
         // Without this a receiver whose root was never sampled (min = max leaves the oracle
-        // nothing to decide) counts as weak and starts at the root (receiver.cpp).
+        // nothing to decide) counts as weak and starts at the root (oracle.cpp).
         o.receiver.weak_receiver = 0;
         // Nothing stands between the floor and the panel: no visibility tests (faster).
         o.receiver.shadows.method = ShadowMethod::None;

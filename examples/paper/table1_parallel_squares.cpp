@@ -1,6 +1,7 @@
 // examples/paper/table1_parallel_squares.cpp - the paper's Table 1: rea (eq. 29) of one transfer
 // between parallel unit squares at distance h, shooter radiosity 1, receiver reflectance 1,
-// receiver at uniform depth d (leaves 2^-d wide), against the analytic form factor (kernel.h).
+// receiver at uniform depth d (leaves 2^-d wide), against the analytic form factor
+// (radiosity/transfer/form_factor.h).
 //
 // Run:    table1_parallel_squares [--order m] [--extrapolation linear|higher] [--eps E |
 //                                  --rhombus-radius R] [--csv] ...

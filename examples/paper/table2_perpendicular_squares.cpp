@@ -1,6 +1,7 @@
 // examples/paper/table2_perpendicular_squares.cpp - the paper's Table 2: rea (eq. 29) of one
 // transfer between perpendicular unit squares sharing an edge, shooter radiosity 1, receiver
-// reflectance 1, receiver at uniform depth d, against the analytic form factor (kernel.h).
+// reflectance 1, receiver at uniform depth d, against the analytic form factor
+// (radiosity/transfer/form_factor.h).
 //
 // Run:    table2_perpendicular_squares [--order m] [--extrapolation linear|higher] [--eps E |
 //                                       --rhombus-radius R] [--csv] ...

@@ -1,4 +1,4 @@
-// radiosity/visibility/hidden_regions.cpp - hidden parts of a surface (hidden.h).
+// radiosity/visibility/hidden_regions.cpp - hidden parts of a surface (hidden_regions.h).
 #include "radiosity/visibility/hidden_regions.h"
 
 #include <algorithm>
