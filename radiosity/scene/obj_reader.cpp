@@ -44,6 +44,7 @@ public:
         while (reader.next(line)) statement(line);
         if (scene_.surfaces.empty()) throw InputError(name_, 0, "the OBJ file has no faces");
         name_surfaces();
+        scene_.input_files = state_.files();
         return std::move(scene_);
     }
 
@@ -188,6 +189,7 @@ private:
         state_.charge(at);
         std::ifstream in;
         open_named(at, "material library", path, in);
+        state_.record(path);
         LineReader reader(in, path);
         Line line;
         MtlEntry entry;
@@ -323,6 +325,7 @@ Texture LoadState::image(const Line& line, const std::string& path) {
     charge(line);
     std::string problem = file_problem(path);
     if (!problem.empty()) line.fail("texture " + in_quotes(path) + ": " + problem);
+    record(path);
     Texture texture;
     try {
         texture = Texture::image(path);
@@ -347,7 +350,9 @@ Scene parse_obj(std::istream& in, const std::string& name) {
 Scene load_obj(const std::string& path) {
     std::ifstream in;
     open_top(path, in);
-    return parse_obj(in, path);
+    LoadState state;
+    state.record(path);
+    return read_obj(in, path, state);
 }
 
 }  // namespace mbr

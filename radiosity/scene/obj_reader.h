@@ -6,6 +6,7 @@
 #include <iosfwd>
 #include <string>
 #include <unordered_map>
+#include <vector>
 
 #include "radiosity/scene/line_reader.h"
 #include "radiosity/scene/scene.h"
@@ -27,11 +28,17 @@ namespace detail {
 constexpr const char* obj_default_material = "obj_default";
 
 /// What the readers of one top-level load share: the count of files opened, which bounds
-/// exponential include trees, and the texture images decoded so far.
+/// exponential include trees, the files opened so far, and the texture images decoded so far.
 class LoadState {
 public:
     /// Counts one more file read on behalf of `line` (at most 1000 per load).
     void charge(const Line& line);
+
+    /// Records that the file at `path` was opened (Scene::input_files).
+    void record(const std::string& path) { files_.push_back(path); }
+
+    /// The files recorded so far, in the order opened.
+    const std::vector<std::string>& files() const { return files_; }
 
     /// The image file at `path` (resolved), unscaled. Each file is read and decoded once per
     /// load, however many materials name it (a big image costs its memory once, not once per
@@ -40,6 +47,7 @@ public:
 
 private:
     int n_files_ = 0;
+    std::vector<std::string> files_;                      // paths opened, in order
     std::unordered_map<std::string, Texture> textures_;  // canonical path -> decoded image
 };
 

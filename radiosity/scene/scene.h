@@ -48,6 +48,10 @@ struct Scene {
     Camera camera;
     bool has_camera = false;
     SolverSettings settings;  // the scene's `set` lines (radiosity/scene/settings.h)
+    /// Every file the readers opened for this scene, in the order read, as the paths opened:
+    /// the scene or OBJ file itself (when loaded from a file), includes, OBJ files, MTL
+    /// libraries and texture images (each image once, however many materials name it).
+    std::vector<std::string> input_files;
 
     /// Index of the material called `name`, or -1.
     int find_material(const std::string& name) const;

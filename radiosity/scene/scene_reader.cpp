@@ -139,6 +139,7 @@ public:
             at.fail("min_depth " + std::to_string(s.min_depth) + " exceeds max_depth " +
                     std::to_string(s.max_depth));
         }
+        scene_.input_files = state_.files();
         return std::move(scene_);
     }
 
@@ -524,6 +525,7 @@ private:
         state_.charge(line);
         std::ifstream in;
         open_named(line, "OBJ file", path, in);
+        state_.record(path);
         Scene part = read_obj(in, path, state_);
         // Merge: the OBJ's materials join the scene's (names must be new, except the shared
         // default material), then its surfaces with their material indices moved along.
@@ -562,6 +564,7 @@ private:
         state_.charge(line);
         std::ifstream in;
         open_named(line, "included file", path, in);
+        state_.record(path);
         read_file(in, path, depth + 1);
     }
 
@@ -600,7 +603,9 @@ Scene parse_scene(std::istream& in, const std::string& name) {
 Scene load_scene(const std::string& path) {
     std::ifstream in;
     open_top(path, in);
-    return parse_scene(in, path);
+    LoadState state;
+    state.record(path);
+    return SceneReader(state).read(in, path);
 }
 
 }  // namespace mbr
