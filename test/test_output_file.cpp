@@ -386,3 +386,49 @@ TEST_CASE("output_file: a full disk gives an error, no temporary file and the ol
     CHECK(read_bytes(target) == old);
     CHECK(names_in(folder) == std::set<std::string>{"ex.png"});
 }
+
+TEST_CASE("output_file: a read-only file and a sticky folder's foreign file are refused first",
+          "[output_file]") {
+    TempDir dir;
+    // As root, permissions stop nobody: the checks run as the user "nobody" (uid 65534) for a
+    // moment then, with files that root owns. An ordinary user tests the read-only file only:
+    // it cannot make a file that another user owns.
+    const bool root = ::geteuid() == 0;
+    REQUIRE(::chmod(dir.path().c_str(), 0777) == 0);
+    const std::string read_only = dir / "read-only.png";
+    write_file(read_only, std::string("old"));
+    REQUIRE(::chmod(read_only.c_str(), 0444) == 0);
+    const std::string sticky = dir / "sticky";
+    fs::create_directory(sticky);
+    REQUIRE(::chmod(sticky.c_str(), 01777) == 0);
+    const std::string foreign = sticky + "/foreign.png";
+    write_file(foreign, std::string("old"));
+    REQUIRE(::chmod(foreign.c_str(), 0666) == 0);  // writable, but not replaceable by others
+
+    if (root && ::seteuid(65534) != 0) {
+        WARN("skipped: cannot act as another user (" << std::strerror(errno) << ")");
+        return;
+    }
+    std::string read_only_message, write_message, foreign_message, own_message;
+    read_only_message = output_error([&] { check_output_path(read_only); });
+    write_message = output_error([&] { write_file(read_only, std::string("new")); });
+    if (root) {
+        foreign_message = output_error([&] { check_output_path(foreign); });
+        // A new file in the sticky folder is fine.
+        own_message = output_error([&] { check_output_path(sticky + "/new.png"); });
+        REQUIRE(::seteuid(0) == 0);
+    }
+    const std::string denied = std::strerror(EACCES);
+    CHECK(read_only_message == read_only + ": cannot write: " + denied);
+    CHECK(write_message == read_only_message);
+    CHECK(read_bytes(read_only) == "old");
+    if (root) {
+        CHECK_THAT(
+            foreign_message,
+            Catch::StartsWith(foreign + ": cannot replace the file: " + std::strerror(EPERM)));
+        CHECK(own_message == "");
+    }
+    CHECK(read_bytes(foreign) == "old");
+    CHECK(names_in(dir.path().string()) == std::set<std::string>{"read-only.png", "sticky"});
+    CHECK(names_in(sticky) == std::set<std::string>{"foreign.png"});
+}

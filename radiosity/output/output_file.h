@@ -10,8 +10,13 @@
 //   - an existing file that is not a regular file (a character device such as /dev/full, a
 //     FIFO, a pipe or terminal behind /dev/stdout): opened and written directly, no rename. A
 //     FIFO without a reader blocks until one comes, as a shell redirection does.
-//   - a directory, a missing folder, a folder without write permission: refused with the
-//     system's reason.
+//   - a directory, a missing folder, a folder without write permission, an existing file the
+//     user may not write (as the shell's `>` refuses it), a file in a sticky folder that only its
+//     owner may replace: refused with the system's reason before anything is written.
+//   - a signal that ends the program by default (SIGINT, SIGTERM, SIGHUP, SIGPIPE, SIGXFSZ)
+//     while temporaries exist: they are removed, then the program ends by that signal as it
+//     would have (the shell's status 130, 143, ...). A signal the program ignores or handles
+//     itself is left alone.
 // The content is complete in memory before the file is touched, so a failure while producing
 // it leaves nothing behind.
 #pragma once
@@ -51,15 +56,26 @@ struct OutputFile {
     std::string bytes;
 };
 
-/// Several files, all or none as far as the file system allows: every path is checked and every
-/// temporary written before any target is replaced. Only a failure while renaming (or while
-/// writing a device or FIFO, which is done last) can leave the earlier files replaced.
+/// Several files, all or none as far as the file system allows: every path is checked (two paths
+/// naming one file are refused), every temporary written, then the devices, FIFOs and standard
+/// streams written, and only then every target renamed, in a row. What can still leave a part
+/// written: a device or FIFO written before a later one fails, a rename failing after earlier
+/// ones (the folder changed since the check), a crash or SIGKILL between two renames.
 void write_files(const std::vector<OutputFile>& files);
 
 /// Throws the OutputError that write_file would throw before writing anything (a directory, a
-/// missing folder, a folder that is read-only or without write permission), so that a program
-/// can refuse its output path before a long computation. Writes nothing.
+/// missing folder, a folder that is read-only or without write permission, a read-only file, a
+/// sticky folder's file of another user), so that a program can refuse its output path before a
+/// long computation. Writes nothing.
 void check_output_path(const std::string& path);
+
+/// check_output_path for each of `outputs` (empty ones skipped), then an OutputError when two
+/// of them name one file (the same device and inode when the file exists, the same path through
+/// the folder's real path when it does not) or when one of them is an existing file among
+/// `inputs` (by device and inode, whatever the spelling: "./x", a symbolic or a hard link).
+/// Writes nothing.
+void check_outputs(const std::vector<std::string>& outputs,
+                   const std::vector<std::string>& inputs = {});
 
 /// True when `path` names the file the process's standard output goes to (/dev/stdout, or the
 /// file or pipe stdout is redirected to). A program writing its result there prints its report
