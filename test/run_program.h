@@ -80,13 +80,24 @@ inline std::string read_fd(int fd) {
     return s;
 }
 
-/// Runs `program ARGS...` with stdin from /dev/null and stdout and stderr captured, or stderr on
-/// `stderr_fd` when that is given (its content is then the caller's to read). The environment is
-/// inherited.
-inline ProgramRun run_program(const std::string& program, const std::vector<std::string>& args,
-                              int stderr_fd = -1) {
-    const int out_fd = capture_file();
-    const int err_fd = stderr_fd >= 0 ? stderr_fd : capture_file();
+/// A program started by start_program and not yet waited for.
+struct StartedProgram {
+    pid_t pid = -1;
+    int out_fd = -1, err_fd = -1;
+    bool own_err = true;  // err_fd is a capture file of ours (not the caller's stderr_fd)
+    std::string program;
+};
+
+/// Starts `program ARGS...` with stdin from /dev/null and stdout and stderr captured, or stderr
+/// on `stderr_fd` when that is given (its content is then the caller's to read). The environment
+/// is inherited. finish_program() waits for it.
+inline StartedProgram start_program(const std::string& program,
+                                    const std::vector<std::string>& args, int stderr_fd = -1) {
+    StartedProgram started;
+    started.program = program;
+    started.out_fd = capture_file();
+    started.own_err = stderr_fd < 0;
+    started.err_fd = stderr_fd >= 0 ? stderr_fd : capture_file();
     std::vector<std::string> words = {program};
     words.insert(words.end(), args.begin(), args.end());
     std::vector<char*> argv;
@@ -96,38 +107,48 @@ inline ProgramRun run_program(const std::string& program, const std::vector<std:
     posix_spawn_file_actions_t actions;
     REQUIRE(posix_spawn_file_actions_init(&actions) == 0);
     posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
-    posix_spawn_file_actions_adddup2(&actions, out_fd, 1);
-    posix_spawn_file_actions_adddup2(&actions, err_fd, 2);
-    posix_spawn_file_actions_addclose(&actions, out_fd);
-    if (err_fd != 2) posix_spawn_file_actions_addclose(&actions, err_fd);
-    pid_t pid = -1;
+    posix_spawn_file_actions_adddup2(&actions, started.out_fd, 1);
+    posix_spawn_file_actions_adddup2(&actions, started.err_fd, 2);
+    posix_spawn_file_actions_addclose(&actions, started.out_fd);
+    if (started.err_fd != 2) posix_spawn_file_actions_addclose(&actions, started.err_fd);
     const int spawned =
-        posix_spawn(&pid, program.c_str(), &actions, nullptr, argv.data(), environ);
+        posix_spawn(&started.pid, program.c_str(), &actions, nullptr, argv.data(), environ);
     posix_spawn_file_actions_destroy(&actions);
     INFO("posix_spawn of " << program);
     REQUIRE(spawned == 0);
+    return started;
+}
 
+/// Waits for a started program (killing it after five minutes) and returns what it did.
+inline ProgramRun finish_program(StartedProgram& started) {
     int wait_status = 0;
     const auto give_up = std::chrono::steady_clock::now() + std::chrono::minutes(5);
     pid_t done = 0;
-    while ((done = ::waitpid(pid, &wait_status, WNOHANG)) == 0 &&
+    while ((done = ::waitpid(started.pid, &wait_status, WNOHANG)) == 0 &&
            std::chrono::steady_clock::now() < give_up)
         std::this_thread::sleep_for(std::chrono::milliseconds(1));
     if (done == 0) {
-        ::kill(pid, SIGKILL);
-        ::waitpid(pid, &wait_status, 0);
+        ::kill(started.pid, SIGKILL);
+        ::waitpid(started.pid, &wait_status, 0);
     }
     ProgramRun run;
-    run.out = read_fd(out_fd);
-    ::close(out_fd);
-    if (stderr_fd < 0) {
-        run.err = read_fd(err_fd);
-        ::close(err_fd);
+    run.out = read_fd(started.out_fd);
+    ::close(started.out_fd);
+    if (started.own_err) {
+        run.err = read_fd(started.err_fd);
+        ::close(started.err_fd);
     }
-    INFO(program << " did not end within five minutes");
-    REQUIRE(done == pid);
+    INFO(started.program << " did not end within five minutes");
+    REQUIRE(done == started.pid);
     run.status = WIFEXITED(wait_status) ? WEXITSTATUS(wait_status) : -WTERMSIG(wait_status);
     return run;
+}
+
+/// Runs `program ARGS...` as start_program starts it and waits for it.
+inline ProgramRun run_program(const std::string& program, const std::vector<std::string>& args,
+                              int stderr_fd = -1) {
+    StartedProgram started = start_program(program, args, stderr_fd);
+    return finish_program(started);
 }
 
 #ifdef MBR_EXAMPLES_DIR

@@ -300,3 +300,29 @@ TEST_CASE("cli: a report that cannot be written to stdout gives status 1 and the
     CHECK(help.status == 1);
     CHECK(help.err == big.err);
 }
+
+TEST_CASE("cli: a word starting with '-' that nobody asked for is an unknown option", "[cli]") {
+    auto positional = [](std::vector<std::string> words) {
+        std::vector<std::string> storage;
+        std::vector<char*> argv;
+        Args args = make_args(std::move(words), storage, argv);
+        (void)args.integer("--rays", 1);
+        std::string joined;
+        for (const std::string& p : args.positional()) joined += "[" + p + "]";
+        return joined;
+    };
+    CHECK(usage_error([&] { positional({"base.scene", "-x"}); }) == "unknown option -x");
+    CHECK(usage_error([&] { positional({"base.scene", "--camera", "0", "1", "3"}); }) ==
+          "unknown option --camera");
+    // Read options, a lone "-" and numbers are not unknown options.
+    CHECK(positional({"--rays", "5", "a.scene", "-", "-1", "-.5"}) == "[a.scene][-][-1][-.5]");
+
+    // An output path that cannot be written is a usage error without the options' hint.
+    const Run r = run({}, [](Args&) -> int {
+        refuse_bad_outputs({"/nonexistent folder of mbr/x.png"});
+        return 0;
+    });
+    CHECK(r.status == 2);
+    CHECK(r.err == "prog: /nonexistent folder of mbr/x.png: cannot write: the folder "
+                   "'/nonexistent folder of mbr' does not exist\n");
+}

@@ -1,22 +1,26 @@
 // test/test_mbr_tool.cpp - the mbr command-line tool (examples/mbr/mbr.cpp) end to end, run as a
 // child process: `mbr render` writes a PNG of the camera's size and nothing else, a
-// missing output folder is status 1 with no file left, bad arguments and bad input are status 2
-// with one stderr line naming the problem, a saved solution loads back to the same image, `mbr
-// probe` prints B at points in their order (the emission on a light, zero on a black surface and
-// the analytic rho E F on a floor under a rectangle light), help and version go to stdout, and
-// no progress bar appears with --quiet or without a terminal.
+// missing output folder is status 2 with no file left, outputs that name an input or each other
+// are refused, a signal leaves no temporary file, outputs are all written or none, bad arguments
+// and bad input are status 2 with one stderr line naming the problem, a saved solution loads back
+// to the same image, `mbr probe` prints B at points in their order (the emission on a light, zero
+// on a black surface and the analytic rho E F on a floor under a rectangle light), help and version
+// go to stdout, and no progress bar appears with --quiet or without a terminal.
 //
 // The tool's path comes from the compile definition MBR_TOOL (test/CMakeLists.txt). It is run
 // by test/run_program.h, no shell, so that the temporary folders' names can hold spaces (they do).
 // The scene is tiny (three rectangles, max_depth 3, at most 3 shots, a 32 x 24 camera, one sample
 // per pixel), so that every run of the tool takes a fraction of a second, also under ASan.
 #include <fcntl.h>
+#include <signal.h>
 #include <stb_image.h>
+#include <sys/stat.h>
 #include <termios.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <catch2/catch.hpp>
+#include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -25,6 +29,7 @@
 #include <set>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "math/vec3.h"
@@ -167,14 +172,15 @@ TEST_CASE("mbr_tool: render writes a PNG of the camera's size and nothing else",
     CHECK(h == camera_height);
 }
 
-TEST_CASE("mbr_tool: a missing output folder is status 1, one line, and no file anywhere",
+TEST_CASE("mbr_tool: a missing output folder is status 2, one line, and no file anywhere",
           "[mbr_tool]") {
     TempFolder dir;
     write_text(dir / "lit floor.scene", lit_floor_scene);
     const std::string out = dir / "missing/x.png";
     const ToolRun run = run_mbr({"render", dir / "lit floor.scene", "-o", out, "--spp", "1"});
     CAPTURE(run);
-    CHECK(run.status == 1);
+    // An output path that cannot be written is a bad command line, found before any work.
+    CHECK(run.status == 2);
     CHECK(is_one_line(run.err));
     CHECK_THAT(run.err, Contains(out));
     CHECK(run.out.empty());
@@ -446,4 +452,240 @@ TEST_CASE("mbr_tool: no progress bar with --quiet or without a terminal", "[mbr_
     std::vector<std::string> quiet = render;
     quiet.push_back("--quiet");
     CHECK(on_terminal(quiet).empty());
+}
+
+TEST_CASE("mbr_tool: an output that is one of the inputs is refused, by the file's identity",
+          "[mbr_tool]") {
+    TempFolder dir;
+    const std::string scene = dir / "lit floor.scene";
+    write_text(scene, lit_floor_scene);
+    const ToolRun saved = run_mbr({"render", scene, "-o", dir / "a.png", "--spp", "1", "--quiet",
+                                   "--save-solution", dir / "s.solution"});
+    CAPTURE(saved);
+    REQUIRE(saved.status == 0);
+    const std::string solution_bytes = read_bytes(dir / "s.solution");
+    // The scene under other spellings: through "./", a symbolic link and a hard link.
+    fs::create_symlink(scene, dir / "link.png");
+    fs::create_hard_link(scene, dir / "hard.png");
+    // A scene that includes another: the included file is an input too.
+    write_text(dir / "inner.scene", lit_floor_scene);
+    write_text(dir / "outer.scene", "include inner.scene\n");
+    const std::string dotted = (dir.path() / "." / "lit floor.scene").string();
+    struct Case {
+        const char* what;
+        std::vector<std::string> args;
+    };
+    const std::vector<std::string> base = {"render", scene, "--spp", "1", "--quiet"};
+    const Case cases[] = {
+        {"-o the scene", {"-o", scene}},
+        {"--hdr the scene", {"-o", dir / "b.png", "--hdr", scene}},
+        {"--save-solution the scene", {"-o", dir / "b.png", "--save-solution", scene}},
+        {"-o the scene, spelt with ./", {"-o", dotted}},
+        {"-o a symbolic link to the scene", {"-o", dir / "link.png"}},
+        {"-o a hard link of the scene", {"-o", dir / "hard.png"}},
+        {"-o the loaded solution",
+         {"-o", dir / "s.solution", "--load-solution", dir / "s.solution"}},
+        {"-o the included scene", {"-o", dir / "inner.scene"}},
+    };
+    for (const Case& c : cases) {
+        std::vector<std::string> args = base;
+        if (c.args.size() == 2 && std::string(c.what) == "-o the included scene")
+            args[1] = dir / "outer.scene";
+        args.insert(args.end(), c.args.begin(), c.args.end());
+        const ToolRun run = run_mbr(args);
+        CAPTURE(c.what, run);
+        CHECK(run.status == 2);
+        CHECK(is_one_line(run.err));
+        CHECK_THAT(run.err, Contains("input"));
+        CHECK(run.out.empty());
+        CHECK(read_bytes(scene) == lit_floor_scene);
+        CHECK(read_bytes(dir / "inner.scene") == lit_floor_scene);
+        CHECK(read_bytes(dir / "s.solution") == solution_bytes);
+        CHECK_FALSE(fs::exists(dir / "b.png"));
+        // (entries_under names the symbolic link by its target, through fs::relative.)
+        CHECK(fs::is_symlink(dir / "link.png"));
+        CHECK(entries_under(dir.path()) ==
+              std::set<std::string>{"lit floor.scene", "a.png", "s.solution", "hard.png",
+                                    "inner.scene", "outer.scene"});
+    }
+}
+
+TEST_CASE("mbr_tool: two outputs naming one file are refused, status 2, nothing written",
+          "[mbr_tool]") {
+    TempFolder dir;
+    const std::string scene = dir / "lit floor.scene";
+    write_text(scene, lit_floor_scene);
+    write_text(dir / "old.png", "old");
+    fs::create_hard_link(dir / "old.png", dir / "old hard.png");
+    const std::string same = dir / "same.png";
+    const std::string dotted = (dir.path() / "." / "same.png").string();
+    const std::string up = (dir.path() / "sub" / ".." / "same.png").string();
+    fs::create_directory(dir / "sub");
+    struct Case {
+        const char* what;
+        std::vector<std::string> args;
+    };
+    const Case cases[] = {
+        {"-o and --hdr alike", {"-o", same, "--hdr", same}},
+        {"-o and --save-solution alike", {"-o", same, "--save-solution", same}},
+        {"--hdr and --save-solution alike",
+         {"-o", dir / "x.png", "--hdr", same, "--save-solution", same}},
+        {"a new file by two spellings", {"-o", same, "--hdr", dotted}},
+        {"a new file through sub/..", {"-o", up, "--save-solution", same}},
+        {"an existing file and its hard link",
+         {"-o", dir / "old.png", "--hdr", dir / "old hard.png"}},
+    };
+    for (const Case& c : cases) {
+        std::vector<std::string> args = {"render", scene, "--spp", "1", "--quiet"};
+        args.insert(args.end(), c.args.begin(), c.args.end());
+        const ToolRun run = run_mbr(args);
+        CAPTURE(c.what, run);
+        CHECK(run.status == 2);
+        CHECK(is_one_line(run.err));
+        CHECK_THAT(run.err, Contains("same file"));
+        CHECK(run.out.empty());
+        CHECK(read_bytes(dir / "old.png") == "old");
+        CHECK(entries_under(dir.path()) ==
+              std::set<std::string>{"lit floor.scene", "old.png", "old hard.png", "sub"});
+    }
+}
+
+TEST_CASE("mbr_tool: a failing image write leaves no solution written: all outputs or none",
+          "[mbr_tool]") {
+    TempFolder dir;
+    const std::string scene = dir / "lit floor.scene";
+    write_text(scene, lit_floor_scene);
+    if (::access("/dev/full", W_OK) != 0) {
+        WARN("skipped: no writable /dev/full here");
+        return;
+    }
+    for (const std::vector<std::string>& outputs :
+         {std::vector<std::string>{"-o", "/dev/full"},
+          std::vector<std::string>{"-o", dir / "x.png", "--hdr", "/dev/full"}}) {
+        std::vector<std::string> args = {
+            "render", scene, "--spp", "1", "--quiet", "--save-solution", dir / "s.solution"};
+        args.insert(args.end(), outputs.begin(), outputs.end());
+        const ToolRun run = run_mbr(args);
+        CAPTURE(run);
+        CHECK(run.status == 1);
+        CHECK(is_one_line(run.err));
+        CHECK_THAT(run.err, Contains("/dev/full"));
+        CHECK(entries_under(dir.path()) == std::set<std::string>{"lit floor.scene"});
+    }
+}
+
+TEST_CASE("mbr_tool: SIGINT or SIGTERM while outputs are written leaves no temporary file",
+          "[mbr_tool]") {
+    for (int sig : {SIGTERM, SIGINT}) {
+        CAPTURE(sig);
+        TempFolder dir;
+        const std::string scene = dir / "lit floor.scene";
+        write_text(scene, lit_floor_scene);
+        // The image goes to a FIFO that nobody reads: the tool blocks there with the other
+        // outputs written to their temporaries, which is when the signal comes.
+        const std::string fifo = dir / "fifo";
+        REQUIRE(::mkfifo(fifo.c_str(), 0600) == 0);
+        mbr::test::StartedProgram started = mbr::test::start_program(
+            MBR_TOOL, {"render", scene, "-o", fifo, "--spp", "1", "--quiet", "--hdr", dir / "x.hdr",
+                       "--save-solution", dir / "s.solution"});
+        auto temporaries = [&] {
+            int n = 0;
+            for (const std::string& name : entries_under(dir.path()))
+                n += name.find(".tmp-") != std::string::npos;
+            return n;
+        };
+        const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+        while (temporaries() < 2 && !fs::exists(dir / "x.hdr") &&
+               std::chrono::steady_clock::now() < give_up)
+            std::this_thread::sleep_for(std::chrono::milliseconds(2));
+        const int seen = temporaries();
+        ::kill(started.pid, sig);
+        const ToolRun run = mbr::test::finish_program(started);
+        CAPTURE(run, seen);
+        CHECK(seen == 2);           // the signal came while the temporaries existed
+        CHECK(run.status == -sig);  // ended by the signal, as the shell's 130 or 143 shows
+        CHECK(entries_under(dir.path()) == std::set<std::string>{"lit floor.scene", "fifo"});
+    }
+}
+
+TEST_CASE("mbr_tool: a destination that cannot be written is refused before any work",
+          "[mbr_tool]") {
+    TempFolder dir;
+    const std::string scene = dir / "lit floor.scene";
+    write_text(scene, lit_floor_scene);
+    fs::create_directory(dir / "images");
+    write_text(dir / "read-only.png", "old");
+    REQUIRE(::chmod((dir / "read-only.png").c_str(), 0444) == 0);
+    struct Case {
+        const char* what;
+        std::vector<std::string> args;
+        std::string named;
+    };
+    std::vector<Case> cases = {
+        {"a folder as -o", {"-o", dir / "images"}, dir / "images"},
+        {"a folder as --save-solution",
+         {"-o", dir / "x.png", "--save-solution", dir / "images"},
+         dir / "images"},
+        {"a missing folder for --hdr",
+         {"-o", dir / "x.png", "--hdr", dir / "missing/x.hdr"},
+         dir / "missing"},
+    };
+    // Root may write a read-only file, as the shell's `>` lets it: that case is tested only for
+    // an ordinary user (test_output_file.cpp tests it as root too, by changing the user).
+    if (::geteuid() != 0)
+        cases.push_back({"a read-only file", {"-o", dir / "read-only.png"}, "read-only.png"});
+    for (const Case& c : cases) {
+        std::vector<std::string> args = {"render", scene, "--spp", "1", "--quiet"};
+        args.insert(args.end(), c.args.begin(), c.args.end());
+        const ToolRun run = run_mbr(args);
+        CAPTURE(c.what, run);
+        CHECK(run.status == 2);
+        CHECK(is_one_line(run.err));
+        CHECK_THAT(run.err, Contains(c.named));
+        CHECK(read_bytes(dir / "read-only.png") == "old");
+        CHECK(entries_under(dir.path()) ==
+              std::set<std::string>{"lit floor.scene", "images", "read-only.png"});
+    }
+}
+
+TEST_CASE("mbr_tool: messages name an unknown option, a 0/0 unshot share and ranges",
+          "[mbr_tool]") {
+    TempFolder dir;
+    const std::string scene = dir / "lit floor.scene";
+    write_text(scene, lit_floor_scene);
+    const std::string out = dir / "out.png";
+    struct Case {
+        const char* what;
+        std::vector<std::string> args;
+        std::string named;
+    };
+    const Case cases[] = {
+        {"a single-dash unknown option", {"render", scene, "-o", out, "-x"}, "unknown option -x"},
+        {"an unknown option with values",
+         {"render", scene, "-o", out, "--camera", "0", "1", "3"},
+         "unknown option --camera"},
+        {"--shots beyond its range",
+         {"render", scene, "-o", out, "--shots", "10000001"},
+         "--shots"},
+        {"--max-depth beyond any integer",
+         {"render", scene, "-o", out, "--max-depth", "99999999999999999999"},
+         "--max-depth"},
+    };
+    for (const Case& c : cases) {
+        const ToolRun run = run_mbr(c.args);
+        CAPTURE(c.what, run);
+        CHECK(run.status == 2);
+        CHECK(is_one_line(run.err));
+        CHECK_THAT(run.err, Contains(c.named));
+        CHECK_FALSE(fs::exists(out));
+    }
+    // A light that emits nothing: no power was emitted and none is left, 0 %, not an empty cell.
+    std::string dark = lit_floor_scene;
+    const std::string emitting = "emission 10 20 30";
+    dark.replace(dark.find(emitting), emitting.size(), "emission 0 0 0");
+    write_text(dir / "dark.scene", dark);
+    const ToolRun run = run_mbr({"render", dir / "dark.scene", "-o", out, "--spp", "1"});
+    CAPTURE(run);
+    CHECK(run.status == 0);
+    CHECK_THAT(run.out, Contains("unshot power left 0 % of emitted"));
 }

@@ -171,10 +171,28 @@ std::vector<double> Args::numbers(const std::string& name, int n) {
     return out;
 }
 
+namespace {
+
+// A word that reads as an option: '-' and more, other than a number such as "-1" or "-.5".
+bool looks_like_option(const std::string& word) {
+    if (word.size() < 2 || word[0] != '-') return false;
+    char* end = nullptr;
+    std::strtod(word.c_str(), &end);
+    return end != word.c_str() + word.size();
+}
+
+}  // namespace
+
 std::vector<std::string> Args::positional() {
+    // DESIGN: an option nobody asked for is named before the positional arguments are counted,
+    // so that "SCENE -x" or "--camera 0 1 3" say "unknown option" rather than "one scene file,
+    // please (got 4)": the words after an unknown option may be its values.
+    for (size_t i = 0; i < tokens_.size(); ++i)
+        if (!used_[i] && looks_like_option(tokens_[i]))
+            throw UsageError("unknown option " + tokens_[i]);
     std::vector<std::string> out;
     for (size_t i = 0; i < tokens_.size(); ++i)
-        if (!used_[i] && tokens_[i].rfind("--", 0) != 0) {
+        if (!used_[i]) {
             used_[i] = true;
             out.push_back(tokens_[i]);
         }
@@ -291,8 +309,9 @@ int run_body(Args& args, const std::function<int(Args&)>& body) {
         }
         return body(args);
     } catch (const UsageError& e) {
-        std::cerr << program << ": " << e.what() << " (" << program
-                  << " --help lists the options)\n";
+        std::cerr << program << ": " << e.what();
+        if (e.help_hint()) std::cerr << " (" << program << " --help lists the options)";
+        std::cerr << "\n";
         return 2;
     } catch (const InputError& e) {
         std::cerr << program << ": " << e.what() << "\n";
@@ -336,6 +355,15 @@ int run_main(int argc, char** argv, const std::string& usage,
 double now_seconds() {
     using clock = std::chrono::steady_clock;
     return std::chrono::duration<double>(clock::now().time_since_epoch()).count();
+}
+
+void refuse_bad_outputs(const std::vector<std::string>& outputs,
+                        const std::vector<std::string>& inputs) {
+    try {
+        check_outputs(outputs, inputs);
+    } catch (const OutputError& e) {
+        throw UsageError(e.what(), false);
+    }
 }
 
 std::string make_output_folder(const std::string& dir) {

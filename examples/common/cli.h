@@ -18,7 +18,14 @@ namespace mbr {
 /// A bad command line; run_main prints the message on one line and exits with 2.
 class UsageError : public std::runtime_error {
 public:
-    using std::runtime_error::runtime_error;
+    /// `help_hint`: the line ends with "(PROGRAM --help lists the options)"; off for a message
+    /// that the options' list would not help with, such as an output path that cannot be written.
+    explicit UsageError(const std::string& message, bool help_hint = true)
+        : std::runtime_error(message), help_hint_(help_hint) {}
+    bool help_hint() const { return help_hint_; }
+
+private:
+    bool help_hint_ = true;
 };
 
 /// Options are read by asking for them; finish() then rejects anything left unread.
@@ -47,7 +54,9 @@ public:
     bool has(const std::string& name) const;
     /// True when "--help" or "-h" is on the line (anywhere).
     bool help_requested() const { return help_; }
-    /// The positional arguments (call after reading every option).
+    /// The positional arguments (call after reading every option). UsageError "unknown option
+    /// X" when a word nobody asked for starts with '-' (and is neither "-" nor a number): it is
+    /// an option misspelt or unknown, not a file, and the words after it may be its values.
     std::vector<std::string> positional();
     /// Throws UsageError naming the first option nobody asked for.
     void finish();
@@ -78,6 +87,13 @@ double read_memory_budget(Args& args);
 /// budget B ..." when cost.bytes exceeds the budget; otherwise, when `slow`, one warning line on
 /// stderr with the expected memory and time.
 void check_cost(const CostEstimate& cost, double budget, const std::string& run, bool slow);
+
+/// The program's output paths (empty ones skipped) checked before any work by check_outputs
+/// (radiosity/output/output_file.h): a path that cannot be written (a missing folder, a folder,
+/// a read-only file or folder), two outputs naming one file, or an output that is one of
+/// `inputs` is a bad command line: UsageError (status 2) with the OutputError's message.
+void refuse_bad_outputs(const std::vector<std::string>& outputs,
+                        const std::vector<std::string>& inputs = {});
 
 /// The folder of a program's images (-o DIR): created with its parents when missing; an
 /// OutputError naming it when it cannot be (a file of that name, no permission). Returns dir.

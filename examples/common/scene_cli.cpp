@@ -202,21 +202,31 @@ Solution solve_scene(SceneRun& run, bool progress) {
                  });
 }
 
+namespace {
+
+// `power` as a percent of the emitted power. DESIGN: a scene that emits nothing has nothing
+// left to shoot: 0 %, not 0/0 (which would print as an empty cell).
+double percent_of_emitted(double power, const SolveStats& stats) {
+    return stats.emitted_power > 0 ? 100 * power / stats.emitted_power : 0.0;
+}
+
+}  // namespace
+
 void print_shots(std::ostream& os, const Scene& scene, const SolveStats& stats) {
     Table t({"shot", "shooter", "shooter_power", "unshot_before_percent", "unshot_after_percent",
              "receivers", "kernel_evals", "rays", "level", "seconds"});
     for (const ShotStats& s : stats.per_shot)
         t.add_row({std::to_string(s.shot), scene.surfaces[s.shooter].name,
                    cell_g(s.shooter_power, 4),
-                   cell_g(100 * s.unshot_before / stats.emitted_power, 4),
-                   cell_g(100 * s.unshot_after / stats.emitted_power, 4),
+                   cell_g(percent_of_emitted(s.unshot_before, stats), 4),
+                   cell_g(percent_of_emitted(s.unshot_after, stats), 4),
                    std::to_string(s.receivers), std::to_string(s.kernel_evals),
                    std::to_string(s.rays), std::to_string(s.finest_level), cell(s.seconds, 3)});
     t.write_text(os);
 }
 
 std::vector<std::string> summary_cells(const SolveStats& st) {
-    return {std::to_string(st.shots), cell_g(100 * st.unshot_power / st.emitted_power, 4),
+    return {std::to_string(st.shots), cell_g(percent_of_emitted(st.unshot_power, st), 4),
             cell(st.seconds, 3), cell(double(st.peak_memory_bytes) / (1024.0 * 1024.0), 1),
             std::to_string(st.coefficients)};
 }
@@ -231,7 +241,7 @@ void print_summary(std::ostream& os, const SceneRun& run, const SolveStats& st) 
     os << run.path << ": " << run.scene.surfaces.size() << " surfaces, "
        << run.octree->polygon_count() << " polygons\n"
        << "shots " << st.shots << (st.converged ? " (converged)" : " (shot limit)")
-       << ", unshot power left " << cell_g(100 * st.unshot_power / st.emitted_power, 4)
+       << ", unshot power left " << cell_g(percent_of_emitted(st.unshot_power, st), 4)
        << " % of emitted\n"
        << "seconds " << cell(st.seconds, 3) << " (" << thread_count() << " threads), peak memory "
        << cell(double(st.peak_memory_bytes) / (1024.0 * 1024.0), 1) << " MiB, coefficients "

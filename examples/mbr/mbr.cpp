@@ -8,8 +8,10 @@
 //   mbr tables                                Tables 1, 2 and 3 beside the paper's values
 //   mbr --help | mbr COMMAND --help | mbr --version
 //
-// Exit status: 0 on success, 2 for bad usage or bad input, 1 for a failure while running; one
-// line on stderr. Output files are written under a temporary name and renamed.
+// Exit status: 0 on success, 2 for bad usage or bad input (an output path that cannot be written,
+// or that names an input or another output, is bad usage: refused before any work), 1 for a
+// failure while running; one line on stderr. The outputs of a run are written all or none
+// (write_files, radiosity/output/output_file.h).
 #include <algorithm>
 #include <cerrno>
 #include <cstring>
@@ -80,8 +82,8 @@ std::string probe_usage() {
 }
 
 /// A solution: solved now (printing the summary unless quiet), or loaded.
-Solution obtain_solution(SceneRun& run, const std::string& load, const std::string& save,
-                         bool report, std::ostream& summary) {
+Solution obtain_solution(SceneRun& run, const std::string& load, bool report,
+                         std::ostream& summary) {
     Solution solution;
     if (!load.empty()) {
         errno = 0;
@@ -93,11 +95,16 @@ Solution obtain_solution(SceneRun& run, const std::string& load, const std::stri
         solution = solve_scene(run, true);
         if (report) print_summary(summary, run, solution.stats);
     }
-    if (!save.empty()) {
-        write_file(save, [&](std::ostream& os) { save_solution(os, run.scene, solution); });
-        if (report) summary << "wrote " << save << "\n";
-    }
     return solution;
+}
+
+/// Every file the run reads: the scene with what it includes (OBJ, MTL, textures) and the
+/// loaded solution, for refuse_bad_outputs.
+std::vector<std::string> run_inputs(const SceneRun& run, const std::string& load) {
+    std::vector<std::string> inputs = run.scene.input_files;
+    inputs.push_back(run.path);
+    inputs.push_back(load);
+    return inputs;
 }
 
 int render_command(Args& args) {
@@ -113,18 +120,28 @@ int render_command(Args& args) {
     if (!save.empty() && !load.empty())
         throw UsageError("--save-solution and --load-solution exclude each other");
     if (!(exposure > 0)) throw UsageError("--exposure must be positive");
-    // Refuse unwritable outputs before any work.
-    check_output_path(out);
-    if (!hdr.empty()) check_output_path(hdr);
-    if (!save.empty()) check_output_path(save);
+    // Refuse outputs that cannot be written, or that clash, before any work; the scene's own
+    // files are known once it is read (and before it is solved).
+    const std::vector<std::string> outputs{out, hdr, save};
+    refuse_bad_outputs(outputs, {load});
     SceneRun run = read_scene_run(args, "");
     args.finish();
+    refuse_bad_outputs(outputs, run_inputs(run, load));
     if (!run.scene.has_camera)
         throw InputError(run.path, 0, "the scene has no camera statement: nothing to render from");
 
     const bool report = !is_standard_output(out) && !is_standard_output(hdr);
     std::ostringstream summary;
-    const Solution solution = obtain_solution(run, load, save, report, summary);
+    const Solution solution = obtain_solution(run, load, report, summary);
+    std::vector<OutputFile> files;
+    if (!save.empty()) {
+        // Written with the images, all or none (radiosity/output/output_file.h).
+        std::ostringstream os;
+        save_solution(os, run.scene, solution);
+        MBR_CHECK_MSG(!os.fail(), "the solution of " << save << " could not be formatted");
+        files.push_back({save, os.str()});
+        if (report) summary << "wrote " << save << "\n";
+    }
     RenderOptions ro;
     ro.samples_per_pixel = spp;
     ro.seed = static_cast<std::uint64_t>(seed);
@@ -134,7 +151,7 @@ int render_command(Args& args) {
     Image display = tone_map(radiance, exposure);
     if (quadtree)
         draw_quadtree_overlay(display, run.scene, *run.octree, &solution.leaves, ro.overlay_colour);
-    std::vector<OutputFile> files{{out, encode_png(display)}};
+    files.push_back({out, encode_png(display)});
     if (!hdr.empty()) {
         std::ostringstream os;
         write_hdr(os, radiance);
@@ -161,7 +178,7 @@ int probe_command(Args& args) {
     const std::vector<SurfaceLocation> at = locate_probe_points(
         run.scene, run.octree->polygons(), points, points_path, probe_tolerance(run.scene));
     std::ostringstream ignored;
-    const Solution solution = obtain_solution(run, load, "", false, ignored);
+    const Solution solution = obtain_solution(run, load, false, ignored);
     std::vector<std::string> names;
     std::vector<Rgb> values;
     for (size_t i = 0; i < points.size(); ++i) {
