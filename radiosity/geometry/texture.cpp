@@ -7,6 +7,8 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 
 #include "math/check.h"
 
@@ -98,7 +100,74 @@ Texture Texture::from_pixels(int width, int height, std::vector<Rgb> linear, Rgb
     return from_shared(std::move(pixels), scale, name);
 }
 
+namespace {
+
+/// True when the file begins with the PNG signature; width and height are then those of its
+/// IHDR chunk, or -1 when the header is cut short or does not begin with IHDR.
+bool is_png(const std::string& path, long& width, long& height) {
+    unsigned char h[24] = {};
+    std::ifstream in(path, std::ios::binary);
+    in.read(reinterpret_cast<char*>(h), sizeof h);
+    const std::streamsize n = in.gcount();
+    static const unsigned char signature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+    if (n < 8) return false;
+    for (int i = 0; i < 8; ++i)
+        if (h[i] != signature[i]) return false;
+    width = height = -1;
+    if (n < 24 || h[12] != 'I' || h[13] != 'H' || h[14] != 'D' || h[15] != 'R') return true;
+    const auto big_endian = [&](int at) {
+        return (long(h[at]) << 24) | (long(h[at + 1]) << 16) | (long(h[at + 2]) << 8) | h[at + 3];
+    };
+    width = big_endian(16);
+    height = big_endian(20);
+    return true;
+}
+
+/// A byte string for a message: printable ASCII as is, other bytes as \xHH.
+std::string printable(const std::string& s) {
+    std::string out;
+    for (unsigned char c : s) {
+        if (c >= 0x20 && c < 0x7f) {
+            out += char(c);
+        } else {
+            const char* hex = "0123456789abcdef";
+            out += "\\x";
+            out += hex[c >> 4];
+            out += hex[c & 15];
+        }
+    }
+    return out;
+}
+
+/// stb_image's reason for a failure, in words. Its reason for an unknown critical PNG chunk,
+/// "XXXX PNG chunk not known", holds the chunk type's four raw bytes and is cut short at a
+/// zero byte among them (every other reason of stb_image has at least 5 characters).
+std::string failure_reason(const char* why, const char* otherwise) {
+    if (!why) return otherwise;
+    const std::string s = why;
+    const std::string suffix = " PNG chunk not known";
+    if (s.size() == 4 + suffix.size() && s.compare(4, std::string::npos, suffix) == 0)
+        return "unknown PNG chunk type '" + printable(s.substr(0, 4)) + "'";
+    if (s.size() < 5) return "unknown PNG chunk type (it holds a zero byte)";
+    return printable(s);
+}
+
+std::string too_many_pixels(long width, long height) {
+    return "texture image is " + std::to_string(width) + " x " + std::to_string(height) +
+           " pixels; at most " + std::to_string(Texture::max_image_pixels) + " pixels are accepted";
+}
+
+}  // namespace
+
 Texture Texture::image(const std::string& path, Rgb scale) {
+    // A folder, a device or a FIFO is refused before it is read (stb_image would read /dev/zero
+    // or wait on a FIFO).
+    namespace fs = std::filesystem;
+    std::error_code ec;
+    const fs::file_status st = fs::status(path, ec);
+    if (!ec && fs::is_directory(st)) throw InputError(path, 0, "is a folder, not a file");
+    if (!ec && fs::exists(st) && !fs::is_regular_file(st))
+        throw InputError(path, 0, "is not a regular file");
     // Ask for the size first, so that an absurd header cannot make stb_image allocate gigabytes.
     int width = 0, height = 0, channels = 0;
     if (!stbi_info(path.c_str(), &width, &height, &channels)) {
@@ -106,22 +175,24 @@ Texture Texture::image(const std::string& path, Rgb scale) {
         std::FILE* f = std::fopen(path.c_str(), "rb");
         if (!f) throw InputError(path, 0, "cannot open the texture file" + system_reason());
         std::fclose(f);
-        const char* why = stbi_failure_reason();
-        throw InputError(
-            path, 0,
-            std::string("cannot read the texture image (") + (why ? why : "unknown format") + ")");
+        const std::string why = failure_reason(stbi_failure_reason(), "unknown format");
+        // stb_image refuses a PNG header of more than 2^30 bytes of pixels ("too large") and
+        // then reports the last format it tried ("unknown image type"): say what the header says.
+        long png_width = 0, png_height = 0;
+        if (is_png(path, png_width, png_height)) {
+            if (png_width > 0 && png_height > 0 && png_width * png_height > max_image_pixels)
+                throw InputError(path, 0, too_many_pixels(png_width, png_height));
+            throw InputError(path, 0,
+                             "cannot read the texture image (a damaged or truncated PNG header)");
+        }
+        throw InputError(path, 0, "cannot read the texture image (" + why + ")");
     }
     if (width < 1 || height < 1 || long(width) * long(height) > max_image_pixels)
-        throw InputError(path, 0,
-                         "texture image is " + std::to_string(width) + " x " +
-                             std::to_string(height) + " pixels; at most " +
-                             std::to_string(max_image_pixels) + " pixels are accepted");
+        throw InputError(path, 0, too_many_pixels(width, height));
     unsigned char* data = stbi_load(path.c_str(), &width, &height, &channels, 3);
     if (!data) {
-        const char* why = stbi_failure_reason();
-        throw InputError(
-            path, 0,
-            std::string("cannot decode the texture image (") + (why ? why : "unknown error") + ")");
+        const std::string why = failure_reason(stbi_failure_reason(), "unknown error");
+        throw InputError(path, 0, "cannot decode the texture image (" + why + ")");
     }
     auto pixels = std::make_shared<Pixels>();
     pixels->width = width;

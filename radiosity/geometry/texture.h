@@ -29,8 +29,10 @@ public:
     /// An image read with stb_image. Each 8-bit channel c is decoded from sRGB to linear
     /// (IEC 61966-2-1) and multiplied by the channel of `scale`: value = scale * linear(c), so a
     /// white texel gives `scale`. Alpha is ignored. u runs left to right, v bottom to top
-    /// (row 0 of the file is v = 1). Throws InputError(path, 0, ...) when the file is missing or
-    /// cannot be decoded, or has more than max_image_pixels pixels.
+    /// (row 0 of the file is v = 1). Throws InputError(path, 0, ...) when the file is missing, is
+    /// a folder, device or FIFO (refused before it is read), cannot be decoded, or has more than
+    /// max_image_pixels pixels (a PNG's size is read from its header even where stb_image
+    /// refuses the header as too large).
     static Texture image(const std::string& path, Rgb scale = {1, 1, 1});
     /// An image from linear texel values, row 0 at the top (v = 1), width * height of them.
     static Texture from_pixels(int width, int height, std::vector<Rgb> linear, Rgb scale,

@@ -16,6 +16,7 @@
 #include <sstream>
 
 #include "math/check.h"
+#include "radiosity/scene/faces_to_quads.h"
 #include "radiosity/scene/line_reader.h"
 
 namespace mbr {
@@ -31,10 +32,11 @@ std::string lower(std::string s) {
 
 // The CSV's lines (radiosity/scene/line_reader.h): fields split at commas and trimmed of spaces
 // and tabs, one trailing '\r' dropped, a UTF-8 byte order mark on line 1 dropped, lines of blanks
-// skipped; no comments, no line-length limit, any bytes inside a field.
+// skipped; no comments, any bytes inside a field, lines of at most max_probe_line bytes (the
+// scene format's limit: a row holds a name and a few numbers).
 LineFormat csv_format() {
     LineFormat f;
-    f.max_length = 0;
+    f.max_length = max_probe_line;
     f.comments = false;
     f.control_bytes = true;
     f.separator = ',';
@@ -294,11 +296,25 @@ std::vector<ProbePoint> parse_probe_points(std::istream& in, const std::string& 
         auto number = [&](const char* key) {
             return parse_field(fields[column[key]], header[column[key]], name, line_no);
         };
+        // A point lies where the scene's surfaces may lie: within the coordinate limit of the
+        // scene format (faces_to_quads.h), beyond which distances to it overflow.
+        for (const char* key : {"x", "y", "z"}) {
+            const double c = number(key);
+            if (!(std::fabs(c) <= max_coordinate))
+                throw InputError(name, line_no,
+                                 "column '" + header[column[key]] + "': " + detail::fmt(c) +
+                                     " exceeds the coordinate limit " +
+                                     detail::fmt(max_coordinate));
+        }
         point.position = {number("x"), number("y"), number("z")};
         if (n_normal == 3) {
-            const Vec3 n{number("nx"), number("ny"), number("nz")};
-            if (!(length(n) > 0))
+            Vec3 n{number("nx"), number("ny"), number("nz")};
+            if (n.x == 0 && n.y == 0 && n.z == 0)
                 throw InputError(name, line_no, "the normal (nx, ny, nz) is zero");
+            // Only the direction counts: scaled to a largest component of 1 first, so that a
+            // normal of huge (or tiny) components neither overflows nor underflows.
+            const double big = std::max({std::fabs(n.x), std::fabs(n.y), std::fabs(n.z)});
+            n = {n.x / big, n.y / big, n.z / big};
             point.has_normal = true;
             point.normal = normalize(n);
         }
@@ -309,9 +325,8 @@ std::vector<ProbePoint> parse_probe_points(std::istream& in, const std::string& 
 }
 
 std::vector<ProbePoint> read_probe_points(const std::string& path) {
-    errno = 0;
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw InputError(path, 0, "cannot open the probe point file" + system_reason());
+    std::ifstream in;
+    detail::open_input(path, "probe point file", in);
     return parse_probe_points(in, path);
 }
 

@@ -4,6 +4,7 @@
 // the parametric map of paper section 2, and results are written back as CSV.
 #pragma once
 
+#include <cstddef>
 #include <iosfwd>
 #include <optional>
 #include <string>
@@ -25,13 +26,18 @@ struct ProbePoint {
     int line = 0;  // line of the file it came from, for messages
 };
 
+/// The longest line of a probe CSV, in bytes; a longer one is refused as soon as it passes this.
+constexpr size_t max_probe_line = 65536;
+
 /// Reads probe points from a CSV file: a header row, then one point per row. Columns `name`,
 /// `x`, `y`, `z` are required, `nx`, `ny`, `nz` optional (all three or none), in any order;
 /// other columns are ignored. Header names are matched without regard to case or surrounding
 /// blanks; fields are trimmed; blank lines are skipped; `\r\n` line ends and a UTF-8 byte order
-/// mark are accepted. Throws InputError(path, line, ...) for a missing or empty file, a missing,
+/// mark are accepted. Throws InputError(path, line, ...) for a missing or empty file, a folder,
+/// device or FIFO (refused before it is read), a line longer than max_probe_line, a missing,
 /// duplicate or half-given (normal) column, a row with the wrong number of fields, an empty or
-/// repeated name, a field that is not a finite number, a zero normal, or a file without points.
+/// repeated name, a field that is not a finite number, a coordinate beyond the scene format's
+/// limit max_coordinate (1e8), a zero normal, or a file without points.
 std::vector<ProbePoint> read_probe_points(const std::string& path);
 
 /// The same from a stream; `name` is used in messages as the file name.

@@ -2,6 +2,7 @@
 // tokens to numbers, file names to open files, each problem one InputError with file and line.
 #include "radiosity/scene/line_reader.h"
 
+#include <algorithm>
 #include <cctype>
 #include <cerrno>
 #include <charconv>
@@ -81,28 +82,56 @@ void LineReader::split_at_separator(std::string raw, Line& line) const {
 
 bool LineReader::read_raw(std::string& raw) {
     raw.clear();
-    std::streambuf* buf = in_.rdbuf();
-    if (!buf || done_) return false;
+    if (!in_.rdbuf() || done_) return false;
     const int number = number_ + 1;
     for (;;) {
-        int c = buf->sbumpc();
-        if (c == std::char_traits<char>::eof()) {
+        if (pos_ == pending_.size() && !refill(number)) {
             done_ = true;
             if (raw.empty()) return false;
             number_ = number;
             return true;
         }
-        if (c == '\n') {
-            number_ = number;
-            return true;
-        }
-        if (format_.max_length > 0 && raw.size() >= format_.max_length)
+        const size_t end = pending_.find('\n', pos_);
+        const size_t stop = end == std::string::npos ? pending_.size() : end;
+        if (format_.max_length > 0 && raw.size() + (stop - pos_) > format_.max_length)
             throw InputError(
                 file_, number,
                 !format_.too_long.empty()
                     ? format_.too_long
                     : "line is longer than " + std::to_string(format_.max_length) + " bytes");
-        raw += char(c);
+        raw.append(pending_, pos_, stop - pos_);
+        pos_ = stop;
+        if (end != std::string::npos) {
+            ++pos_;
+            number_ = number;
+            return true;
+        }
+    }
+}
+
+bool LineReader::refill(int number) {
+    std::streambuf* buf = in_.rdbuf();
+    pending_.clear();
+    pos_ = 0;
+    try {
+        errno = 0;
+        const std::streamsize buffered = buf->in_avail();
+        if (buffered > 0) {
+            pending_.resize(size_t(std::min<std::streamsize>(buffered, 1 << 16)));
+            pending_.resize(size_t(buf->sgetn(&pending_[0], std::streamsize(pending_.size()))));
+            return !pending_.empty();
+        }
+        const int c = buf->sbumpc();
+        if (c == std::char_traits<char>::eof()) return false;
+        pending_.assign(1, char(c));
+        return true;
+    } catch (const std::exception&) {
+        // A file stream throws from its buffer when reading fails: a folder opened as a file
+        // (Linux opens it; the first read gives EISDIR) or an I/O error.
+        const int err = errno;
+        done_ = true;
+        if (err == EISDIR) throw InputError(file_, 0, "is a folder, not a file");
+        throw InputError(file_, number, "cannot read the file" + system_reason());
     }
 }
 
@@ -243,6 +272,16 @@ void open_top(const std::string& path, std::ifstream& in) {
     errno = 0;
     in.open(path, std::ios::binary);
     if (!in) throw InputError(path, 0, "cannot open the file" + system_reason());
+}
+
+void open_input(const std::string& path, const std::string& what, std::ifstream& in) {
+    std::error_code ec;
+    const fs::file_status st = fs::status(path, ec);
+    if (!ec && fs::exists(st) && !fs::is_regular_file(st))
+        throw InputError(path, 0, file_problem(path));
+    errno = 0;
+    in.open(path, std::ios::binary);
+    if (!in) throw InputError(path, 0, "cannot open the " + what + system_reason());
 }
 
 }  // namespace detail

@@ -44,7 +44,10 @@ struct Line {
 };
 
 /// Reads statements from a stream: splits each line into tokens as `format` says, skips blank
-/// (and comment) lines unless told not to, refuses over-long lines and control bytes.
+/// (and comment) lines unless told not to, refuses over-long lines and control bytes. A line is
+/// read byte by byte and refused as soon as it passes format.max_length, so an endless input
+/// (a device, a line without end) costs at most that much memory. A stream that fails to read
+/// (a folder opened as a file, an I/O error) is an InputError, not a stream exception.
 class LineReader {
 public:
     /// Reads `in`; `file` names it in every Line and message.
@@ -59,6 +62,10 @@ public:
 private:
     /// One physical line without its '\n'; false when the input is exhausted.
     bool read_raw(std::string& raw);
+    /// Refills pending_ with the bytes the stream holds buffered (at least one byte, waiting
+    /// for it as a read does; never more than are buffered, so an interactive stream is not
+    /// waited on beyond its line); false at the end of the input. `number` is for messages.
+    bool refill(int number);
     /// Splits at blanks (' ', '\t', '\r', '\v', '\f'), refusing control bytes unless allowed.
     void split_at_blanks(const std::string& raw, Line& line) const;
     /// Splits at format_.separator, trimming each field of spaces and tabs.
@@ -69,6 +76,8 @@ private:
     LineFormat format_;
     int number_ = 0;
     bool done_ = false;
+    std::string pending_;  // bytes taken from the stream and not yet returned
+    size_t pos_ = 0;       // the first of them not yet returned
 };
 
 namespace detail {
@@ -116,6 +125,12 @@ void open_named(const Line& line, const std::string& what, const std::string& pa
 
 /// Opens a top-level file for reading (binary), or throws InputError(path, 0, ...).
 void open_top(const std::string& path, std::ifstream& in);
+
+/// Opens a top-level file of the kind `what` ("solution file", ...) for reading (binary): a
+/// folder, a device or a FIFO is refused as open_top refuses it, before a byte is read; a file
+/// that cannot be opened gets "cannot open the WHAT" and the system's reason. Throws
+/// InputError(path, 0, ...).
+void open_input(const std::string& path, const std::string& what, std::ifstream& in);
 
 }  // namespace detail
 

@@ -238,9 +238,13 @@ private:
             e.has_kd = true;
         } else if (key == "Ke") {
             Rgb ke = mtl_colour(line);
-            for (int i = 0; i < 3; ++i)
+            for (int i = 0; i < 3; ++i) {
                 if (ke[i] < 0) line.fail("Ke " + fmt(ke[i]) + " is negative");
-            if (!std::isfinite(Pi * max_abs(ke))) line.fail("Ke is too large");
+                // The scene format's limit on the emission E = pi Ke (scene.h).
+                if (Pi * ke[i] > max_emission)
+                    line.fail("Ke " + fmt(ke[i]) + " exceeds the limit " + fmt(max_emission / Pi) +
+                              " (the emission E = pi Ke is at most " + fmt(max_emission) + ")");
+            }
             e.ke = ke;
         } else if (key == "map_Kd" || key == "map_Ke") {
             // Options (-s, -o, -bm, ...) come first; the file name is the last token.

@@ -14,8 +14,14 @@
 
 namespace mbr {
 
+/// The largest emission channel E of eq. (1) that the readers accept, from the scene format's
+/// `emission` and from MTL's Ke alike (E = pi Ke): far beyond any light's, yet small enough that
+/// the solver's sums of E x area (areas up to max_coordinate^2) and their squares stay finite.
+constexpr double max_emission = 1e30;
+
 /// A Lambertian material. Reflectance channels lie in [0,1); emission is the emitted radiosity
-/// E of eq. (1) (power per area, pi times the emitted radiance), each channel >= 0.
+/// E of eq. (1) (power per area, pi times the emitted radiance), each channel in
+/// [0, max_emission].
 struct Material {
     std::string name;
     Texture reflectance;  // rho(u,v), channels in [0, 1)

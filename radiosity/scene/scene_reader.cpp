@@ -213,6 +213,8 @@ private:
             if (reflectance && !(c[i] >= 0 && c[i] < 1))
                 line.fail(what + " " + fmt(c[i]) + " is outside [0, 1)");
             if (!reflectance && c[i] < 0) line.fail(what + " " + fmt(c[i]) + " is negative");
+            if (!reflectance && c[i] > max_emission)
+                line.fail(what + " " + fmt(c[i]) + " exceeds the limit " + fmt(max_emission));
         }
     }
 

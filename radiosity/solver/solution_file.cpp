@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <fstream>
 #include <istream>
 #include <ostream>
 
@@ -231,6 +232,12 @@ Solution load_solution(std::istream& in, const std::string& name, const Scene& s
     const std::vector<std::string> end = r.words("'end'");
     if (end.size() != 1 || end[0] != "end") r.fail("expected 'end'");
     return s;
+}
+
+Solution load_solution(const std::string& path, const Scene& scene) {
+    std::ifstream in;
+    detail::open_input(path, "solution file", in);
+    return load_solution(in, path, scene);
 }
 
 }  // namespace mbr

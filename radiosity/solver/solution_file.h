@@ -20,6 +20,9 @@ struct Solution;  // radiosity/solver/solver.h
 void save_solution(std::ostream& out, const Scene& scene, const Solution& solution);
 /// Reads what save_solution wrote for `scene`; throws InputError(name, line, ...).
 Solution load_solution(std::istream& in, const std::string& name, const Scene& scene);
+/// Reads the solution file at `path` for `scene`. Refuses what is not a regular file (a folder,
+/// a device, a FIFO) before reading a byte: InputError(path, 0, ...).
+Solution load_solution(const std::string& path, const Scene& scene);
 
 /// A fingerprint of the scene's surfaces and materials (names, kinds, corners, reflectance and
 /// emission means), for matching solution files to scenes.
