@@ -1,19 +1,23 @@
 // test/fuzz_readers.cpp - the long-running fuzz driver for every reader of outside
-// data: scene files, OBJ, MTL and solution files (docs/fuzzing.md). g++ has no libFuzzer, so this
-// is a deterministic mutation loop: seed corpora, seeded mutations (test/fuzz_mutate.h plus
-// extreme numbers), each input written to a file and read the way the programs read it. The
+// data: scene files, OBJ, MTL, solution files and probe CSVs (docs/fuzzing.md). g++ has no
+// libFuzzer, so this is a deterministic mutation loop: seed corpora, seeded mutations
+// (test/fuzz_mutate.h plus extreme numbers), each input written to a file and read the way the
+// programs read it; first, each reader is also given what is not a file of lines (a folder,
+// /dev/zero, a FIFO) and a line one byte over its limit. The
 // only accepted failure is an InputError; any other exception, a broken promise of the readers,
 // an input slower than --slow seconds, or (in the MBR_SANITIZE build) a sanitizer report is a
 // find. Not part of mbr_tests and not a CTest test: it runs for minutes.
 //
-//   mbr_fuzz_readers [--inputs N] [--seed S] [--reader scene|obj|mtl|solution|all]
+//   mbr_fuzz_readers [--inputs N] [--seed S] [--reader scene|obj|mtl|solution|probe|all]
 //                    [--finds DIR] [--slow SECONDS]
 //
 // Input i of reader r is made by its own generator, seeded from (S, r, i), so one input can be
 // replayed alone: --reader r --first i --inputs 1.
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -27,6 +31,7 @@
 
 #include "math/check.h"
 #include "octree/octree.h"
+#include "radiosity/reference/probe.h"
 #include "radiosity/scene/scene_io.h"
 #include "radiosity/scene/scene_octree.h"
 #include "radiosity/solver/solver.h"
@@ -130,7 +135,45 @@ struct Target {
     std::vector<std::string> corpus;
     fs::path file;  // where each input is written
     std::function<std::string(const fs::path&)> read;
+    size_t max_line = 65536;  // the reader's line limit, for the over-long line
 };
+
+/// Inputs that are not files of lines, put where the target reads its input, each refused with
+/// an InputError (without reading /dev/zero to its end or waiting on the FIFO), and a first
+/// line one byte over the limit before the seed. Returns the finds as "what: problem".
+std::vector<std::string> special_inputs(const Target& t, double slow) {
+    std::vector<std::string> finds;
+    const auto check = [&](const std::string& what) {
+        const auto t0 = std::chrono::steady_clock::now();
+        std::string find;
+        try {
+            find = t.read(t.file);
+            if (find.empty()) find = "accepted";
+        } catch (const InputError& e) {
+            if (e.message().empty()) find = "an InputError without a message";
+        } catch (const std::exception& e) {
+            find = std::string("not an InputError: ") + e.what();
+        }
+        const double seconds =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        if (find.empty() && seconds > slow) find = "slow: " + std::to_string(seconds) + " s";
+        if (!find.empty()) finds.push_back(what + ": " + find);
+    };
+    std::error_code ec;
+    fs::remove_all(t.file, ec);
+    fs::create_directory(t.file, ec);
+    check("a folder");
+    fs::remove_all(t.file, ec);
+    fs::create_symlink("/dev/zero", t.file, ec);
+    if (!ec) check("/dev/zero");
+    fs::remove_all(t.file, ec);
+    if (::mkfifo(t.file.c_str(), 0600) == 0) check("a FIFO");
+    fs::remove_all(t.file, ec);
+    write_text(t.file, std::string(t.max_line + 1, '7') + "\n" + t.corpus[0]);
+    check("a line of " + std::to_string(t.max_line + 1) + " bytes");
+    fs::remove_all(t.file, ec);
+    return finds;
+}
 
 struct Counts {
     long inputs = 0, accepted = 0, refused = 0, finds = 0;
@@ -205,12 +248,25 @@ int main(int argc, char** argv) {
                        {saved.str()},
                        dir / "fuzz.solution",
                        [&squares](const fs::path& f) -> std::string {
-                           std::ifstream in(f, std::ios::binary);
-                           const Solution s = load_solution(in, f.string(), squares);
+                           const Solution s = load_solution(f.string(), squares);
                            if (s.radiosity.size() != squares.surfaces.size() ||
                                s.unshot.size() != squares.surfaces.size())
                                return "a solution of the wrong size";
                            return "";
+                       },
+                       size_t(1) << 26});
+    targets.push_back({"probe",
+                       {"name,x,y,z\na,0.5,0.5,0\nb,0.25,0.75,1\n",
+                        "\xEF\xBB\xBFName , X,y,Z,nx,ny,nz,note\r\np,0.5,0.5,0,0,0,1,x\r\n"},
+                       dir / "fuzz.csv",
+                       [](const fs::path& f) -> std::string {
+                           const std::vector<ProbePoint> points = read_probe_points(f.string());
+                           for (const ProbePoint& p : points)
+                               if (!(std::fabs(p.position.x) <= max_coordinate &&
+                                     std::fabs(p.position.y) <= max_coordinate &&
+                                     std::fabs(p.position.z) <= max_coordinate))
+                                   return "a point beyond the coordinate limit";
+                           return points.empty() ? "no points" : "";
                        }});
 
     std::cout << "mbr_fuzz_readers: seed " << seed << ", scratch folder " << dir
@@ -229,6 +285,11 @@ int main(int argc, char** argv) {
         Counts c;
         const long n = n_inputs / n_selected;
         const auto start = std::chrono::steady_clock::now();
+        if (first == 0)
+            for (const std::string& find : special_inputs(t, slow)) {
+                ++c.finds;
+                std::cout << "FIND " << t.name << " " << find << std::endl;
+            }
         for (long i = first; i < first + n; ++i) {
             std::seed_seq ss{std::uint32_t(seed), std::uint32_t(seed >> 32), std::uint32_t(r),
                              std::uint32_t(i), std::uint32_t(i >> 32)};
