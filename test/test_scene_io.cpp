@@ -909,8 +909,7 @@ TEST_CASE("scene_io: counts in messages agree with their nouns", "[scene_io][err
                     "normal index 1 is out of range (0 normals defined");
 }
 
-TEST_CASE("scene_io: the scene records every file its readers opened, in order",
-          "[scene_io]") {
+TEST_CASE("scene_io: the scene records every file its readers opened, in order", "[scene_io]") {
     // The scene, its includes, OBJ files, MTL libraries and textures, each once (a texture named
     // twice is read once), as the paths opened; text parsed from a stream is no file opened.
     TempDir dir;
@@ -920,8 +919,9 @@ TEST_CASE("scene_io: the scene records every file its readers opened, in order",
                                std::filesystem::copy_options::overwrite_existing);
     const std::string p = dir.path.string() + "/";
     dir.write("t.mtl", "newmtl poster\nKd 0.5 0.5 0.5\nmap_Kd b.png\n");
-    dir.write("t.obj", "mtllib t.mtl\nusemtl poster\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
-                       "f 1 2 3 4\n");
+    dir.write("t.obj",
+              "mtllib t.mtl\nusemtl poster\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
+              "f 1 2 3 4\n");
     dir.write("inc.scene", "material c reflectance image a.png\n");
     const std::string top = dir.write("top.scene",
                                       "material a reflectance image a.png\n"
@@ -929,15 +929,14 @@ TEST_CASE("scene_io: the scene records every file its readers opened, in order",
                                       "rectangle r a 0 0 0  1 0 0  0 1 0\n"
                                       "obj t.obj\n");
     Scene s = load_scene(top);
-    CHECK(s.input_files == std::vector<std::string>{top, p + "a.png", p + "inc.scene",
-                                                     p + "t.obj", p + "t.mtl", p + "b.png"});
+    CHECK(s.input_files == std::vector<std::string>{top, p + "a.png", p + "inc.scene", p + "t.obj",
+                                                    p + "t.mtl", p + "b.png"});
     Scene o = load_obj(p + "t.obj");
     CHECK(o.input_files == std::vector<std::string>{p + "t.obj", p + "t.mtl", p + "b.png"});
     std::ifstream in(top);
     Scene streamed = parse_scene(in, top);
-    CHECK(streamed.input_files ==
-          std::vector<std::string>{p + "a.png", p + "inc.scene", p + "t.obj", p + "t.mtl",
-                                   p + "b.png"});
+    CHECK(streamed.input_files == std::vector<std::string>{p + "a.png", p + "inc.scene",
+                                                           p + "t.obj", p + "t.mtl", p + "b.png"});
 }
 
 TEST_CASE("scene_io: an image named by several materials is decoded once", "[scene_io][texture]") {

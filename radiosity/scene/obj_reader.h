@@ -47,7 +47,7 @@ public:
 
 private:
     int n_files_ = 0;
-    std::vector<std::string> files_;                      // paths opened, in order
+    std::vector<std::string> files_;                     // paths opened, in order
     std::unordered_map<std::string, Texture> textures_;  // canonical path -> decoded image
 };
 
