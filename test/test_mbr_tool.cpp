@@ -689,3 +689,32 @@ TEST_CASE("mbr_tool: messages name an unknown option, a 0/0 unshot share and ran
     CHECK(run.status == 0);
     CHECK_THAT(run.out, Contains("unshot power left 0 % of emitted"));
 }
+
+TEST_CASE("mbr_tool: the picture's memory is in the estimate, said before the solve",
+          "[mbr_tool]") {
+    // An 8192 x 8192 picture holds about 3.5 GiB (radiosity/output/render.h, render_bytes): a
+    // budget of 50 MiB must refuse it before anything is solved or written, where it used to be
+    // accepted and run out of memory at the render.
+    TempFolder dir;
+    std::string scene = lit_floor_scene;
+    const std::string size = "size " + std::to_string(camera_width) + " " +
+                             std::to_string(camera_height);
+    const size_t at = scene.find(size);
+    REQUIRE(at != std::string::npos);
+    scene.replace(at, size.size(), "size 8192 8192");
+    write_text(dir / "big.scene", scene);
+    const ToolRun run = run_mbr({"render", dir / "big.scene", "-o", dir / "out.png", "--spp", "1",
+                                 "--memory-budget", "50M", "--quiet"});
+    CAPTURE(run);
+    CHECK(run.status == 2);
+    CHECK(is_one_line(run.err));
+    CHECK_THAT(run.err, Contains("8192 x 8192"));
+    CHECK_THAT(run.err, Contains("image 3.5 GiB"));
+    CHECK(entries_under(dir.path()) == std::set<std::string>{"big.scene"});
+    // The same scene at its own size fits.
+    write_text(dir / "small.scene", lit_floor_scene);
+    const ToolRun small = run_mbr({"render", dir / "small.scene", "-o", dir / "out.png", "--spp",
+                                   "1", "--memory-budget", "50M", "--quiet"});
+    CAPTURE(small);
+    CHECK(small.status == 0);
+}

@@ -123,11 +123,12 @@ double read_memory_budget(Args& args) {
     return parse_memory_size(args.text("--memory-budget", ""), "--memory-budget");
 }
 
-void check_cost(const CostEstimate& cost, double budget, const std::string& run, bool slow) {
+void check_cost(const CostEstimate& cost, double budget, const std::string& run, bool slow,
+                const std::string& to_lower) {
     if (cost.bytes > budget)
         throw UsageError(run + " needs about " + format_bytes(cost.bytes) + " (" + cost.detail +
                          "), more than the memory budget of " + format_bytes(budget) +
-                         ": lower the depth, or raise --memory-budget");
+                         ": lower " + to_lower + ", or raise --memory-budget");
     if (slow)
         std::cerr << "warning: " << run << " is slow: expect about " << format_bytes(cost.bytes)
                   << " of memory and " << format_seconds(cost.seconds) << " of one core\n";
@@ -333,8 +334,30 @@ int run_body(Args& args, const std::function<int(Args&)>& body) {
 
 }  // namespace
 
+/// DESIGN: OpenMP's threads wait passively (they sleep) at the end of a parallel loop unless the
+/// user chose a policy with OMP_WAIT_POLICY. The solver runs many short parallel loops; threads
+/// that spin between them cost little on an idle machine but take the cores a loaded machine's
+/// other processes need (docs/method.md, "Threads on a busy machine"). The GNU runtime reads
+/// the variable once, when it loads, before main: so the program sets it and starts itself
+/// again, once (the variable is then set). Where it cannot (no /proc), it goes on as it is. Only
+/// a process's own command line restarts it (glibc's program_invocation_name is its argv[0]):
+/// run_main called with a made-up one, as the tests do, runs in place.
+void wait_passively(char** argv) {
+#ifdef _OPENMP
+    if (argv == nullptr || argv[0] != program_invocation_name) return;
+    if (std::getenv("OMP_WAIT_POLICY") != nullptr) return;
+    if (setenv("OMP_WAIT_POLICY", "passive", 1) != 0) return;
+    std::cout.flush();
+    std::fflush(nullptr);
+    execv("/proc/self/exe", argv);
+#else
+    (void)argv;
+#endif
+}
+
 int run_main(int argc, char** argv, const std::string& usage,
              const std::function<int(Args&)>& body) {
+    wait_passively(argv);
     Args args(argc, argv, usage);
     // Whatever was printed before goes out first, through the old buffer.
     std::cout.flush();

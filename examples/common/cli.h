@@ -84,9 +84,10 @@ extern const char* memory_budget_usage;
 /// (radiosity/solver/cost.h).
 double read_memory_budget(Args& args);
 /// Says the cost before it is spent: UsageError "<run> needs about N, more than the memory
-/// budget B ..." when cost.bytes exceeds the budget; otherwise, when `slow`, one warning line on
-/// stderr with the expected memory and time.
-void check_cost(const CostEstimate& cost, double budget, const std::string& run, bool slow);
+/// budget B ...: lower <to_lower>, or raise --memory-budget" when cost.bytes exceeds the budget;
+/// otherwise, when `slow`, one warning line on stderr with the expected memory and time.
+void check_cost(const CostEstimate& cost, double budget, const std::string& run, bool slow,
+                const std::string& to_lower = "the depth");
 
 /// The program's output paths (empty ones skipped) checked before any work by check_outputs
 /// (radiosity/output/output_file.h): a path that cannot be written (a missing folder, a folder,
@@ -118,6 +119,11 @@ private:
 std::string cell(double value, int digits);
 /// A number with `digits` significant digits ("%.*g").
 std::string cell_g(double value, int digits);
+
+/// Starts the process again with OMP_WAIT_POLICY=passive unless the variable is set (so that
+/// OpenMP's threads sleep, not spin, between parallel loops), when `argv` is the process's own
+/// command line; run_main does it first. Returns (doing nothing) where it cannot restart.
+void wait_passively(char** argv);
 
 /// Runs body(args) and maps exceptions to exit codes: 2 for UsageError and InputError (bad
 /// input), 1 for OutputError and any other failure, each with one line on stderr. With --help

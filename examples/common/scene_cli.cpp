@@ -81,6 +81,13 @@ SolverArgs read_solver_args(Args& args, SceneRun& run) {
     return a;
 }
 
+/// "room.scene (27 surfaces, max depth 6, tessellation 24)": a run for messages.
+std::string describe_run(const SceneRun& run) {
+    return run.path + " (" + std::to_string(run.scene.surfaces.size()) + " surfaces, max depth " +
+           std::to_string(run.options.receiver.max_depth) + ", tessellation " +
+           std::to_string(run.scene.settings.tessellation) + ")";
+}
+
 /// The scene's settings, then the command line over them; threads; the octree.
 void finish_scene_run(const SolverArgs& a, SceneRun& run) {
     SolverSettings s = run.scene.settings;
@@ -102,11 +109,9 @@ void finish_scene_run(const SolverArgs& a, SceneRun& run) {
 #endif
     // The cost is said before it is spent: before the octree and the solve allocate.
     const int d = o.receiver.max_depth;
-    check_cost(scene_cost(run.scene, o, thread_count()), a.memory_budget,
-               run.path + " (" + std::to_string(run.scene.surfaces.size()) +
-                   " surfaces, max depth " + std::to_string(d) + ", tessellation " +
-                   std::to_string(run.scene.settings.tessellation) + ")",
-               d >= slow_receiver_depth);
+    run.cost = scene_cost(run.scene, o, thread_count());
+    run.memory_budget = a.memory_budget;
+    check_cost(run.cost, run.memory_budget, describe_run(run), d >= slow_receiver_depth);
     // A light a hair's breadth from a surface is taken as lying on it: say so, once.
     const std::vector<NearContact> near = near_contacts(run.scene);
     if (!near.empty()) {
@@ -124,6 +129,18 @@ void finish_scene_run(const SolverArgs& a, SceneRun& run) {
 }
 
 }  // namespace
+
+void check_render_cost(const SceneRun& run, const RenderOptions& options) {
+    const Camera& camera = run.scene.camera;
+    const double image = render_bytes(camera.width, camera.height, options);
+    CostEstimate c = run.cost;
+    c.bytes += image;
+    c.detail += ", image " + format_bytes(image);
+    check_cost(c, run.memory_budget,
+               describe_run(run) + " rendered at " + std::to_string(camera.width) + " x " +
+                   std::to_string(camera.height),
+               false, "the depth or the camera's size");
+}
 
 SceneRun read_scene_run(Args& args, const std::string& default_scene) {
     SceneRun run;

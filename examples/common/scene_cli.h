@@ -12,6 +12,7 @@
 #include "octree/octree.h"
 #include "radiosity/output/render.h"
 #include "radiosity/scene/scene.h"
+#include "radiosity/solver/cost.h"
 #include "radiosity/solver/solver.h"
 
 namespace mbr {
@@ -28,7 +29,14 @@ struct SceneRun {
     int threads = 0;                 // 0: OpenMP's default
     bool quiet = false;              // no progress bar
     std::unique_ptr<Octree> octree;  // over scene_polygons(scene, settings.tessellation)
+    CostEstimate cost;               // the solve's estimate (radiosity/solver/cost.h)
+    double memory_budget = 0;        // --memory-budget (bytes)
 };
+
+/// Says the cost of the solve and of a picture of the scene's camera together before either is
+/// spent (check_cost with render_bytes of radiosity/output/render.h added): UsageError when it
+/// exceeds the run's memory budget.
+void check_render_cost(const SceneRun& run, const RenderOptions& options);
 
 /// Reads the solver options (every flag of the option table, radiosity/scene/settings.h, with
 /// its aliases such as --shots and --rays; --threads, --quiet, --memory-budget), then the scene

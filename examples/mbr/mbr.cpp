@@ -86,10 +86,7 @@ Solution obtain_solution(SceneRun& run, const std::string& load, bool report,
                          std::ostream& summary) {
     Solution solution;
     if (!load.empty()) {
-        errno = 0;
-        std::ifstream in(load);
-        if (!in) throw InputError(load, 0, "cannot open the solution file" + system_reason());
-        solution = load_solution(in, load, run.scene);
+        solution = load_solution(load, run.scene);  // refuses folders, devices and FIFOs
         if (report) summary << "loaded " << load << "\n";
     } else {
         solution = solve_scene(run, true);
@@ -129,6 +126,12 @@ int render_command(Args& args) {
     refuse_bad_outputs(outputs, run_inputs(run, load));
     if (!run.scene.has_camera)
         throw InputError(run.path, 0, "the scene has no camera statement: nothing to render from");
+    RenderOptions ro;
+    ro.samples_per_pixel = spp;
+    ro.seed = static_cast<std::uint64_t>(seed);
+    ro.exposure = exposure;
+    ro.quadtree_overlay = quadtree;
+    check_render_cost(run, ro);  // the picture's memory too, before the solve
 
     const bool report = !is_standard_output(out) && !is_standard_output(hdr);
     std::ostringstream summary;
@@ -142,10 +145,6 @@ int render_command(Args& args) {
         files.push_back({save, os.str()});
         if (report) summary << "wrote " << save << "\n";
     }
-    RenderOptions ro;
-    ro.samples_per_pixel = spp;
-    ro.seed = static_cast<std::uint64_t>(seed);
-    ro.exposure = exposure;
     const double start = now_seconds();
     const Image radiance = render_radiance(run.scene, *run.octree, solution.radiosity, ro);
     Image display = tone_map(radiance, exposure);
@@ -210,6 +209,7 @@ struct Command {
 
 int main(int argc, char** argv) {
     using namespace mbr;
+    wait_passively(argv);  // before the commands' run_main, whose argv is made up
     const std::string first = argc > 1 ? argv[1] : "";
     if (first == "--version") {
         std::cout << "mbr " << MBR_VERSION

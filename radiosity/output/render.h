@@ -39,6 +39,11 @@ struct RenderStats {
     RenderStats& operator+=(const RenderStats& other);
 };
 
+/// Peak memory of rendering a width x height picture to PNG (and HDR), from its size alone:
+/// the linear radiance and the tone-mapped image (an Rgb a pixel each), the 8-bit pixels and
+/// stb's PNG encoding, and with the quadtree overlay the surface and leaf seen at each pixel.
+double render_bytes(int width, int height, const RenderOptions& options = {});
+
 /// The pinhole ray of scene-format.md through image point (x, y) in pixels, (0, 0) the top left
 /// corner of the image and (width, height) the bottom right; the image's right is
 /// (look_at - eye) x up. The direction is not normalised (t counts distances to the image plane).
