@@ -23,6 +23,7 @@
 #include "radiosity/transfer/transfer.h"
 #include "radiosity/visibility/occlusion.h"
 #include "radiosity/visibility/visible_parts.h"
+#include "test/clip_reference.h"
 #include "test/report.h"
 
 namespace mbr::test {
@@ -251,31 +252,6 @@ inline Brute brute_shadowed(Vec3 p, Vec3 n_p, const Surface& shooter,
     };
     cell(Rect{0, 1, 0, 1}, tol, 0);
     return out;
-}
-
-/// Clips a polygon by the closed box (Sutherland-Hodgman against six planes): whether anything
-/// is left (test_octree.cpp's exact reference, repeated here).
-inline bool polygon_meets_box(const std::vector<Vec3>& polygon, const Box3& box) {
-    std::vector<Vec3> poly = polygon, out;
-    for (int axis = 0; axis < 3; ++axis)
-        for (int side = 0; side < 2; ++side) {
-            const double bound = side == 0 ? box.lo[axis] : box.hi[axis];
-            auto in = [&](Vec3 p) { return side == 0 ? p[axis] >= bound : p[axis] <= bound; };
-            out.clear();
-            const int n = static_cast<int>(poly.size());
-            for (int i = 0; i < n; ++i) {
-                const Vec3 p = poly[i], q = poly[(i + 1) % n];
-                if (in(p)) out.push_back(p);
-                if (in(p) != in(q)) {
-                    Vec3 x = p + ((bound - p[axis]) / (q[axis] - p[axis])) * (q - p);
-                    x[axis] = bound;
-                    out.push_back(x);
-                }
-            }
-            poly.swap(out);
-            if (poly.empty()) return false;
-        }
-    return true;
 }
 
 /// The largest gap between the convex hull of `pts` and the convex polygon `poly` over a

@@ -10,6 +10,7 @@
 
 #include "math/check.h"
 #include "octree/octree.h"
+#include "test/clip_reference.h"
 
 using namespace mbr;
 
@@ -50,31 +51,9 @@ Box3 cube_at(Vec3 centre, double side) {
     return Box3{centre - h, centre + h};
 }
 
-// The exact reference for node-polygon intersection: Sutherland-Hodgman clipping of the polygon
-// by the six closed half-spaces of the cube; the polygon meets the cube iff something is left.
-// Clipping by an axis plane sets that coordinate of a new vertex exactly to the bound, so the
-// only rounding is in the other two coordinates of interpolated vertices (O(1e-16) relative).
+// The exact reference for node-polygon intersection (test/clip_reference.h).
 bool clip_reference_meets(const Box3& cube, const std::vector<Vec3>& polygon) {
-    std::vector<Vec3> poly = polygon, out;
-    for (int axis = 0; axis < 3; ++axis)
-        for (int side = 0; side < 2; ++side) {
-            double bound = side == 0 ? cube.lo[axis] : cube.hi[axis];
-            auto in = [&](Vec3 p) { return side == 0 ? p[axis] >= bound : p[axis] <= bound; };
-            out.clear();
-            int n = static_cast<int>(poly.size());
-            for (int i = 0; i < n; ++i) {
-                Vec3 p = poly[i], q = poly[(i + 1) % n];
-                if (in(p)) out.push_back(p);
-                if (in(p) != in(q)) {
-                    Vec3 x = p + ((bound - p[axis]) / (q[axis] - p[axis])) * (q - p);
-                    x[axis] = bound;
-                    out.push_back(x);
-                }
-            }
-            poly.swap(out);
-            if (poly.empty()) return false;
-        }
-    return true;
+    return polygon_meets_box(polygon, cube);
 }
 
 // Step 3 alone: the polygon's plane has cube corners on both sides (or on it).
