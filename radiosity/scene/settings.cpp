@@ -108,7 +108,7 @@ std::vector<OptionSpec> make_option_table() {
                     "stop when the largest unshot power is below this fraction of the emitted "
                     "power"),
         switch_option("self_transfer", &S::self_transfer,
-                      "a concave curved surface receives from itself"),
+                      "a surface that can see itself (an inward cylinder or sphere patch) receives from itself; planar surfaces never do"),
         integer_option("tessellation", &S::tessellation, 1, 1024, "T",
                        "facets per curved parameter direction when rays are cast at curved "
                        "surfaces (at least 3 along an angle; one along a cylinder's height or a "

@@ -49,7 +49,7 @@ struct SolverSettings {
     int shadow_rays = 4;         // rays per fulcrum per shooter patch, eq. (28)
     int max_shots = 100;         // cap on progressive shots
     double convergence = 1e-3;   // stop when the largest unshot power < this x emitted
-    bool self_transfer = false;  // may a concave curved surface light itself
+    bool self_transfer = true;  // a surface that can see itself (concave curved) lights itself
     int tessellation = 16;       // facets per parameter direction for ray casting
     ShadowSetting shadows = ShadowSetting::Exact;
     double tolerance = 2e-3;  // accuracy relative to the scene's radiosity scale

@@ -35,7 +35,7 @@ struct SolverOptions {
     ReceiverOptions receiver;    // every transfer's options (order, depths, shadows, ...)
     int max_shots = 100;         // stop after this many shots
     double convergence = 1e-3;   // stop when the largest unshot power < this x emitted
-    bool self_transfer = false;  // concave curved surfaces receive from themselves
+    bool self_transfer = true;   // concave curved surfaces receive from themselves
     double tolerance = 2e-3;     // accuracy relative to the scene's radiosity scale: the
                                  //   absolute tolerance of every transfer (see file comment)
     /// The quadrature's absolute tolerance, as a share of the transfer's (a constant).
