@@ -127,8 +127,8 @@ TEST_CASE("render: a constant field filling the view renders to B / pi, in PNG a
     const Rgb B{0.3, 1.2, 2.5};
     const Rgb L = InvPi * B;
     RenderStats stats;
-    const Image radiance =
-        render_radiance(scene, octree, {SplineField::constant(4, 2, B)}, {}, &stats);
+    const Image radiance = render_radiance(
+        scene, octree, std::vector<SplineField>{SplineField::constant(4, 2, B)}, {}, &stats);
     REQUIRE(radiance.width == image_size);
     REQUIRE(radiance.height == image_size);
     CHECK(stats.n_camera_rays == 4L * image_size * image_size);
@@ -217,7 +217,8 @@ TEST_CASE("render: the back of a one-sided surface and a miss are black", "[rend
     }
     SECTION("an empty field") {
         const Scene scene = quad_scene();
-        const Image image = render_radiance(scene, build_octree(scene), {SplineField()});
+        const Image image =
+            render_radiance(scene, build_octree(scene), std::vector<SplineField>{SplineField()});
         CHECK(n_not_black(image) == 0);
     }
 }

@@ -378,10 +378,18 @@ TEST_CASE("solver: damaged, truncated and foreign solution files are refused", "
               std::string::npos);
     }
     SECTION("another version: refused") {
+        std::string v3 = text;
+        v3.replace(0, v3.find('\n'), "mbr-solution 3");
+        CHECK(load_error(v3, scene).find("x.solution:1: solution format version 3 is not "
+                                         "supported (this mbr reads versions 1 to 2)") == 0);
+        // Version 2 reads version 1's lines; only version 2 may name an irradiance field.
         std::string v2 = text;
         v2.replace(0, v2.find('\n'), "mbr-solution 2");
-        CHECK(load_error(v2, scene).find("x.solution:1: solution format version 2 is not "
-                                         "supported") == 0);
+        CHECK(load_error(v2, scene).empty());
+        std::string h1 = text;
+        h1.replace(h1.find("radiosity level"), 9, "irradiance");
+        CHECK(load_error(h1, scene).find("expected 'radiosity' with 2 values") !=
+              std::string::npos);
         CHECK(load_error("P6\n", scene).find("not an mbr solution file") != std::string::npos);
     }
 }
@@ -448,11 +456,14 @@ TEST_CASE("solver: near_contacts names a light a hair above the floor, not a res
     // floor receives, so nothing is reported; a block standing on the floor touches it exactly
     // (rounding only) and is not reported either.
     auto scene_with_gap = [](const std::string& gap) {
-        return scene_from("material light reflectance 0 0 0 emission 1 1 1\n"
-                          "material grey reflectance 0.5 0.5 0.5\n"
-                          "rectangle floor grey 0 0 0  0 0 1  1 0 0\n"
-                          "rectangle light light 0.3 " + gap + " 0.3  0.4 0 0  0 0 0.4\n"
-                          "box block light 0.6 0 0.6  0.9 0.2 0.9\n");  // glows: checked
+        return scene_from(
+            "material light reflectance 0 0 0 emission 1 1 1\n"
+            "material grey reflectance 0.5 0.5 0.5\n"
+            "rectangle floor grey 0 0 0  0 0 1  1 0 0\n"
+            "rectangle light light 0.3 " +
+            gap +
+            " 0.3  0.4 0 0  0 0 0.4\n"
+            "box block light 0.6 0 0.6  0.9 0.2 0.9\n");  // glows: checked
     };
     const Scene hair = scene_with_gap("1e-9");
     const std::vector<NearContact> near = near_contacts(hair);

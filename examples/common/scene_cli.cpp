@@ -271,7 +271,7 @@ double write_render(const SceneRun& run, const Solution& solution, const std::st
     if (!run.scene.has_camera)
         throw InputError(run.path, 0, "the scene has no camera statement: nothing to render from");
     const double start = now_seconds();
-    const Image radiance = render_radiance(run.scene, *run.octree, solution.radiosity, options);
+    const Image radiance = render_radiance(run.scene, *run.octree, radiosity_view(run.scene, solution), options);
     write_files({{path, encode_png(tone_map(radiance, options.exposure))}});
     return now_seconds() - start;
 }

@@ -146,7 +146,7 @@ int render_command(Args& args) {
         if (report) summary << "wrote " << save << "\n";
     }
     const double start = now_seconds();
-    const Image radiance = render_radiance(run.scene, *run.octree, solution.radiosity, ro);
+    const Image radiance = render_radiance(run.scene, *run.octree, radiosity_view(run.scene, solution), ro);
     Image display = tone_map(radiance, exposure);
     if (quadtree)
         draw_quadtree_overlay(display, run.scene, *run.octree, &solution.leaves, ro.overlay_colour);
@@ -180,9 +180,10 @@ int probe_command(Args& args) {
     const Solution solution = obtain_solution(run, load, false, ignored);
     std::vector<std::string> names;
     std::vector<Rgb> values;
+    const RadiosityView view = radiosity_view(run.scene, solution);  // B = E + rho H for H fields
     for (size_t i = 0; i < points.size(); ++i) {
         names.push_back(points[i].name);
-        values.push_back(solution.radiosity[at[i].surface].evaluate(at[i].u, at[i].v));
+        values.push_back(view.at(at[i].surface, at[i].u, at[i].v));
     }
     write_radiosity_csv(std::cout, names, values);
     return 0;

@@ -189,8 +189,9 @@ int run(Args& args) {
         r.seconds = now_seconds() - start;
         r.stats = solution.stats;
         int n_lit = 0, n_shadow = 0;
+        const RadiosityView view = radiosity_view(run.scene, solution);
         for (size_t i = 0; i < ref.size(); ++i) {
-            const Rgb B = solution.radiosity[at[i].surface].evaluate(at[i].u, at[i].v);
+            const Rgb B = view.at(at[i].surface, at[i].u, at[i].v);
             const double e = luminance(B) / luminance(ref[i].B) - 1;
             r.errors.push_back(e);
             r.mean += std::fabs(e);
@@ -215,7 +216,8 @@ int run(Args& args) {
             const Camera full = scene.camera;
             scene.camera.width = w;
             scene.camera.height = h;
-            const Image radiance = render_radiance(scene, *run.octree, solution.radiosity, ro);
+            const Image radiance =
+                render_radiance(scene, *run.octree, radiosity_view(scene, solution), ro);
             scene.camera = full;
             Image error(w, h, {0.5, 0.5, 0.5});
             for (int y = 0; y < h; ++y)

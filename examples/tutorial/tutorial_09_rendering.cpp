@@ -204,8 +204,8 @@ int run(Args& args) {
     // closest_hit per sample, B / pi by eq. (20) at the hit) + tone_map (sRGB).
     const std::string render_png = (std::filesystem::path(dir) / "tutorial_09_render.png").string();
     RenderStats render_stats;
-    write_png(render_png,
-              render_display(scene, octree, solution.radiosity, render, nullptr, &render_stats));
+    write_png(render_png, render_display(scene, octree, radiosity_view(scene, solution), render,
+                                         nullptr, &render_stats));
     std::cout << "camera rays: " << render_stats.n_camera_rays << " (" << scene.camera.width
               << " x " << scene.camera.height << " pixels, " << render.samples_per_pixel
               << " per pixel)\n";
@@ -225,9 +225,10 @@ int run(Args& args) {
     int n_lit = 0, n_shadow = 0;
     std::string worst_name;
     std::vector<double> errors;
+    const RadiosityView view = radiosity_view(scene, solution);  // B = E + rho H where it holds H
     for (size_t i = 0; i < points.size(); ++i) {
         const Reference& r = ref.at(points[i].name);
-        const Rgb B = solution.radiosity[at[i].surface].evaluate(at[i].u, at[i].v);
+        const Rgb B = view.at(at[i].surface, at[i].u, at[i].v);
         const double e = luminance(B) / luminance(r.B) - 1;
         errors.push_back(e);
         sum += std::fabs(e);
@@ -263,7 +264,7 @@ int run(Args& args) {
         camera.height = h;
         Scene small = scene;
         small.camera = camera;
-        const Image ours = render_radiance(small, octree, solution.radiosity, render);
+        const Image ours = render_radiance(small, octree, radiosity_view(scene, solution), render);
         Image reference(w, h);
         for (size_t i = 0; i < reference.pixels.size(); ++i)
             for (int k = 0; k < 3; ++k) reference.pixels[i][k] = data[3 * i + k] / 255.0;

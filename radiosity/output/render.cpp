@@ -74,8 +74,8 @@ private:
     std::uint64_t state_;
 };
 
-void check_fields(const Scene& scene, const std::vector<SplineField>& radiosity) {
-    MBR_CHECK(radiosity.size() == scene.surfaces.size());
+void check_fields(const Scene& scene, const RadiosityView& radiosity) {
+    MBR_CHECK(radiosity.size() == static_cast<int>(scene.surfaces.size()));
 }
 
 // The one-sidedness test and the (surface, u, v) of a camera ray, shared by the radiance and
@@ -104,12 +104,11 @@ std::optional<FrontHit> front_hit(const Octree& octree, const Ray& ray, RenderSt
     return FrontHit{hit->surface, std::clamp(hit->uv.x, 0.0, 1.0), std::clamp(hit->uv.y, 0.0, 1.0)};
 }
 
-Rgb radiance_at(const std::vector<SplineField>& radiosity, const std::optional<FrontHit>& hit) {
+Rgb radiance_at(const RadiosityView& radiosity, const std::optional<FrontHit>& hit) {
     if (!hit) return {};
-    MBR_CHECK(hit->surface >= 0 && hit->surface < static_cast<int>(radiosity.size()));
-    const SplineField& B_i = radiosity[hit->surface];
-    if (B_i.empty()) return {};
-    return InvPi * B_i.evaluate(hit->u, hit->v);  // Lambertian: L = B / pi
+    MBR_CHECK(hit->surface >= 0 && hit->surface < radiosity.size());
+    // Lambertian: L = B / pi, with B = E + rho H where the field holds H (radiosity_view.h).
+    return InvPi * radiosity.at(hit->surface, hit->u, hit->v);
 }
 
 // The leaves of one surface's quadtree, found by (level, i, j) from the coarsest level down.
@@ -315,8 +314,8 @@ Ray camera_ray(const Camera& camera, double x, double y) {
     return CameraFrame(camera).ray(x, y);
 }
 
-Rgb radiance_along(const Scene& scene, const Octree& octree,
-                   const std::vector<SplineField>& radiosity, const Ray& ray, RenderStats* stats) {
+Rgb radiance_along(const Scene& scene, const Octree& octree, const RadiosityView& radiosity,
+                   const Ray& ray, RenderStats* stats) {
     check_fields(scene, radiosity);
     return radiance_at(radiosity, front_hit(octree, ray, stats));
 }
@@ -331,9 +330,8 @@ double render_bytes(int width, int height, const RenderOptions& options) {
     return pixels * (56.0 + (options.quadtree_overlay ? 8.0 : 0.0));
 }
 
-Image render_radiance(const Scene& scene, const Octree& octree,
-                      const std::vector<SplineField>& radiosity, const RenderOptions& options,
-                      RenderStats* stats) {
+Image render_radiance(const Scene& scene, const Octree& octree, const RadiosityView& radiosity,
+                      const RenderOptions& options, RenderStats* stats) {
     check_fields(scene, radiosity);
     MBR_CHECK(options.samples_per_pixel >= 1);
     const CameraFrame camera(scene.camera);
@@ -424,8 +422,8 @@ void draw_quadtree_overlay(Image& display, const Scene& scene, const Octree& oct
         for (const RenderStats& s : row_stats) *stats += s;
 }
 
-Image render_display(const Scene& scene, const Octree& octree,
-                     const std::vector<SplineField>& radiosity, const RenderOptions& options,
+Image render_display(const Scene& scene, const Octree& octree, const RadiosityView& radiosity,
+                     const RenderOptions& options,
                      const std::vector<std::vector<DyadicCell>>* leaves, RenderStats* stats) {
     Image display =
         tone_map(render_radiance(scene, octree, radiosity, options, stats), options.exposure);

@@ -13,6 +13,7 @@
 #include "math/vec3.h"
 #include "octree/octree.h"
 #include "radiosity/geometry/quadtree.h"
+#include "radiosity/geometry/radiosity_view.h"
 #include "radiosity/geometry/spline_field.h"
 #include "radiosity/output/image.h"
 #include "radiosity/scene/scene.h"
@@ -50,20 +51,19 @@ double render_bytes(int width, int height, const RenderOptions& options = {});
 Ray camera_ray(const Camera& camera, double x, double y);
 
 /// Radiance arriving along `ray`: at the first surface i hit, B_i(u, v) / pi by eq. (20) from
-/// radiosity[i] with (u, v) clamped to [0,1]^2; zero for a miss, for the back of a surface and
+/// radiosity.at(i, u, v) (radiosity_view() of a solution, or a list of B fields) with (u, v)
+/// clamped to [0,1]^2; zero for a miss, for the back of a surface and
 /// for an empty field. Adds its counts to *stats if given.
-Rgb radiance_along(const Scene& scene, const Octree& octree,
-                   const std::vector<SplineField>& radiosity, const Ray& ray,
-                   RenderStats* stats = nullptr);
+Rgb radiance_along(const Scene& scene, const Octree& octree, const RadiosityView& radiosity,
+                   const Ray& ray, RenderStats* stats = nullptr);
 
 /// The linear radiance image of scene.camera: per pixel the plain average (box filter) of
-/// options.samples_per_pixel radiance_along() samples jittered inside the pixel. radiosity[i] is
-/// the total radiosity of scene.surfaces[i] (emission included), the same number of them as
-/// surfaces. Parallel over rows; the image does not depend on the number of threads. Values are
-/// not clamped. *stats, if given, receives this render's counts.
-Image render_radiance(const Scene& scene, const Octree& octree,
-                      const std::vector<SplineField>& radiosity, const RenderOptions& options = {},
-                      RenderStats* stats = nullptr);
+/// options.samples_per_pixel radiance_along() samples jittered inside the pixel. radiosity gives
+/// the total radiosity of each of scene.surfaces (emission included), one per surface. Parallel
+/// over rows; the image does not depend on the number of threads. Values are not clamped. *stats,
+/// if given, receives this render's counts.
+Image render_radiance(const Scene& scene, const Octree& octree, const RadiosityView& radiosity,
+                      const RenderOptions& options = {}, RenderStats* stats = nullptr);
 
 /// The sRGB encoding function (IEC 61966-2-1): linear [0,1] to an encoded value in [0,1].
 double linear_to_srgb(double linear);
@@ -83,8 +83,8 @@ void draw_quadtree_overlay(Image& display, const Scene& scene, const Octree& oct
 
 /// The whole display pipeline: render_radiance, tone_map with options.exposure, and, when
 /// options.quadtree_overlay is on, draw_quadtree_overlay with `leaves`.
-Image render_display(const Scene& scene, const Octree& octree,
-                     const std::vector<SplineField>& radiosity, const RenderOptions& options = {},
+Image render_display(const Scene& scene, const Octree& octree, const RadiosityView& radiosity,
+                     const RenderOptions& options = {},
                      const std::vector<std::vector<DyadicCell>>* leaves = nullptr,
                      RenderStats* stats = nullptr);
 

@@ -108,7 +108,8 @@ std::vector<OptionSpec> make_option_table() {
                     "stop when the largest unshot power is below this fraction of the emitted "
                     "power"),
         switch_option("self_transfer", &S::self_transfer,
-                      "a surface that can see itself (an inward cylinder or sphere patch) receives from itself; planar surfaces never do"),
+                      "a surface that can see itself (an inward cylinder or sphere patch) receives "
+                      "from itself; planar surfaces never do"),
         integer_option("tessellation", &S::tessellation, 1, 1024, "T",
                        "facets per curved parameter direction when rays are cast at curved "
                        "surfaces (at least 3 along an angle; one along a cylinder's height or a "
@@ -140,6 +141,11 @@ std::vector<OptionSpec> make_option_table() {
                       "polynomial through the m^2 samples predicting the others (follows B at "
                       "shared edges and corners, at more cost; docs/method.md), or the paper's "
                       "two means"),
+        choice_option("texture_field", &S::texture_field, {"irradiance", "radiosity"},
+                      "what a surface with a textured reflectance stores as its spline field: "
+                      "the irradiance H, with B = E + rho H formed at every sample and pixel "
+                      "(the texture at its own resolution, never ringing below zero), or the "
+                      "radiosity B itself (the paper's)"),
     };
 }
 

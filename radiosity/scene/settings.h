@@ -36,6 +36,12 @@ enum class ContactOracleSetting {
     Means           // "means": the paper's two means
 };
 
+/// What a surface with a textured reflectance stores as its spline field.
+enum class TextureFieldSetting {
+    Irradiance,  // "irradiance": H, with B = E + rho H formed at samples and pixels
+    Radiosity    // "radiosity": B itself (the paper's representation)
+};
+
 /// The settings of the progressive loop (section 4) and of one transfer (section 5). The
 /// initial values are the defaults; option_table() describes each field.
 struct SolverSettings {
@@ -46,11 +52,11 @@ struct SolverSettings {
     double truncation_eps = 1e-6;    // relative cut-off of |DN x DN| (rhombus, Figure 3)
     double rhombus_radius = 0;       // in cells; 0: derived from truncation_eps
     ExtrapolationSetting extrapolation = ExtrapolationSetting::Linear;
-    int shadow_rays = 4;         // rays per fulcrum per shooter patch, eq. (28)
-    int max_shots = 100;         // cap on progressive shots
-    double convergence = 1e-3;   // stop when the largest unshot power < this x emitted
+    int shadow_rays = 4;        // rays per fulcrum per shooter patch, eq. (28)
+    int max_shots = 100;        // cap on progressive shots
+    double convergence = 1e-3;  // stop when the largest unshot power < this x emitted
     bool self_transfer = true;  // a surface that can see itself (concave curved) lights itself
-    int tessellation = 16;       // facets per parameter direction for ray casting
+    int tessellation = 16;      // facets per parameter direction for ray casting
     ShadowSetting shadows = ShadowSetting::Exact;
     double tolerance = 2e-3;  // accuracy relative to the scene's radiosity scale
     UnifySetting unify = UnifySetting::Projection;
@@ -60,6 +66,7 @@ struct SolverSettings {
     int contact_depth = 2;  // receiver cells touching a planar shooter split to at
                             //   least this level (0: off)
     ContactOracleSetting contact_oracle = ContactOracleSetting::Means;
+    TextureFieldSetting texture_field = TextureFieldSetting::Irradiance;
 };
 
 /// One row of the option table.

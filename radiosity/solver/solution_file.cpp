@@ -22,7 +22,17 @@ namespace mbr {
 namespace {
 
 constexpr const char* magic = "mbr-solution";
-constexpr int format_version = 1;
+// Version 2 adds `irradiance level J` in place of `radiosity level J` for a field that holds H
+// (FieldQuantity::irradiance). A solution without such fields is written as version 1, which
+// every earlier mbr reads; both versions are read.
+constexpr int format_version = 2;
+constexpr int oldest_version = 1;
+
+bool any_irradiance(const Solution& solution) {
+    for (FieldQuantity q : solution.quantity)
+        if (q == FieldQuantity::irradiance) return true;
+    return false;
+}
 
 std::uint64_t mix(std::uint64_t h, std::uint64_t x) {
     h ^= x + 0x9e3779b97f4a7c15ULL + (h << 6) + (h >> 2);
@@ -104,8 +114,14 @@ private:
     LineReader lines_;
 };
 
-SplineField read_field(Reader& r, const char* what, int m) {
-    const std::vector<std::string> head = r.words(what);
+/// A field line `WHAT level J` and its three channel lines; `alternative`, when given, is a
+/// second accepted WHAT, and *found_alternative says which one the file has.
+SplineField read_field(Reader& r, const char* what, int m, const char* alternative = nullptr,
+                       bool* found_alternative = nullptr) {
+    std::vector<std::string> head = r.words(what);
+    const bool other = alternative && !head.empty() && head[0] == alternative;
+    if (found_alternative) *found_alternative = other;
+    if (other) head[0] = what;
     r.expect(head, what, 3);
     if (head[1] != "level") r.fail(std::string("expected '") + what + " level J'");
     const int level = int(r.integer(head[2], 0, 14, "a level"));
@@ -159,12 +175,15 @@ void save_solution(std::ostream& out, const Scene& scene, const Solution& soluti
     std::snprintf(fp, sizeof fp, "%016" PRIx64, scene_fingerprint(scene));
     int m = 0;
     for (const SplineField& f : solution.radiosity) m = std::max(m, f.order());
-    out << magic << " " << format_version << "\n"
+    const bool irradiance = any_irradiance(solution);
+    MBR_CHECK(solution.quantity.empty() || solution.quantity.size() == scene.surfaces.size());
+    out << magic << " " << (irradiance ? format_version : oldest_version) << "\n"
         << "fingerprint " << fp << "\n"
         << "surfaces " << scene.surfaces.size() << " order " << m << "\n";
     for (size_t i = 0; i < scene.surfaces.size(); ++i) {
         out << "surface " << i << " " << scene.surfaces[i].name << "\n";
-        write_field(out, "radiosity", solution.radiosity[i]);
+        const bool holds_h = irradiance && solution.quantity[i] == FieldQuantity::irradiance;
+        write_field(out, holds_h ? "irradiance" : "radiosity", solution.radiosity[i]);
         write_field(out, "unshot", solution.unshot[i]);
         const std::vector<DyadicCell> none;
         const std::vector<DyadicCell>& leaves =
@@ -183,9 +202,10 @@ Solution load_solution(std::istream& in, const std::string& name, const Scene& s
     if (head.size() != 2 || head[0] != magic)
         r.fail("not an mbr solution file (no 'mbr-solution' header)");
     const long version = r.integer(head[1], 0, 1000000, "a format version");
-    if (version != format_version)
+    if (version < oldest_version || version > format_version)
         r.fail("solution format version " + std::to_string(version) +
-               " is not supported (this mbr reads version " + std::to_string(format_version) + ")");
+               " is not supported (this mbr reads versions " + std::to_string(oldest_version) +
+               " to " + std::to_string(format_version) + ")");
     const std::vector<std::string> fp = r.words("the fingerprint");
     r.expect(fp, "fingerprint", 2);
     char expected[32];
@@ -204,6 +224,7 @@ Solution load_solution(std::istream& in, const std::string& name, const Scene& s
     const int m = int(r.integer(sizes[3], 2, 8, "an order"));
     Solution s;
     s.radiosity.resize(n);
+    s.quantity.assign(n, FieldQuantity::radiosity);
     s.unshot.resize(n);
     s.leaves.resize(n);
     for (long i = 0; i < n; ++i) {
@@ -213,7 +234,11 @@ Solution load_solution(std::istream& in, const std::string& name, const Scene& s
         if (sh[2] != scene.surfaces[i].name)
             r.fail("surface " + std::to_string(i) + " is '" + sh[2] + "', the scene's is '" +
                    scene.surfaces[i].name + "'");
-        s.radiosity[i] = read_field(r, "radiosity", m);
+        // Version 2: the field line names what the field holds.
+        bool holds_h = false;
+        s.radiosity[i] =
+            read_field(r, "radiosity", m, version >= 2 ? "irradiance" : nullptr, &holds_h);
+        if (holds_h) s.quantity[i] = FieldQuantity::irradiance;
         s.unshot[i] = read_field(r, "unshot", m);
         const std::vector<std::string> lh = r.words("leaves");
         r.expect(lh, "leaves", 2);

@@ -23,6 +23,7 @@
 
 #include "octree/octree.h"
 #include "radiosity/geometry/quadtree.h"
+#include "radiosity/geometry/radiosity_view.h"
 #include "radiosity/geometry/spline_field.h"
 #include "radiosity/scene/scene.h"
 #include "radiosity/transfer/transfer.h"
@@ -32,29 +33,31 @@ namespace mbr {
 
 /// Options of the progressive loop and of its transfers.
 struct SolverOptions {
-    ReceiverOptions receiver;    // every transfer's options (order, depths, shadows, ...)
-    int max_shots = 100;         // stop after this many shots
-    double convergence = 1e-3;   // stop when the largest unshot power < this x emitted
-    bool self_transfer = true;   // concave curved surfaces receive from themselves
-    double tolerance = 2e-3;     // accuracy relative to the scene's radiosity scale: the
-                                 //   absolute tolerance of every transfer (see file comment)
+    ReceiverOptions receiver;   // every transfer's options (order, depths, shadows, ...)
+    int max_shots = 100;        // stop after this many shots
+    double convergence = 1e-3;  // stop when the largest unshot power < this x emitted
+    bool self_transfer = true;  // concave curved surfaces receive from themselves
+    double tolerance = 2e-3;    // accuracy relative to the scene's radiosity scale: the
+                                //   absolute tolerance of every transfer (see file comment)
     /// The quadrature's absolute tolerance, as a share of the transfer's (a constant).
     static constexpr double quadrature_share = 1;
     /// The level at which a textured emission is projected (a constant).
     static constexpr int emission_level = 5;
-    bool hidden_regions = true;  // beyond the paper: samples at points that see no front
-                                 //   face take the nearest visible point's value
-                                 //   (radiosity/visibility/hidden_regions.h)
-    int shooter_level = 3;       // a shooter's unshot field is coarsened to at most this
-                                 //   level (the paper's "lower resolution version", section
-                                 //   6); the receiver options' shooter_coarsening levels at
-                                 //   least (levels 4 and 5 measured: docs/method.md)
-    bool ambient = true;         // beyond the paper: at the end, the power still unshot is
-                                 //   sent on through the measured coupling of the surfaces
-                                 //   (the fraction of each shooter's power each receiver got,
-                                 //   over all its shots) and added as a constant radiosity per
-                                 //   surface (Cohen et al. 1988's ambient term, with measured
-                                 //   instead of area-weighted coupling)
+    bool hidden_regions = true;     // beyond the paper: samples at points that see no front
+                                    //   face take the nearest visible point's value
+                                    //   (radiosity/visibility/hidden_regions.h)
+    int shooter_level = 3;          // a shooter's unshot field is coarsened to at most this
+                                    //   level (the paper's "lower resolution version", section
+                                    //   6); the receiver options' shooter_coarsening levels at
+                                    //   least (levels 4 and 5 measured: docs/method.md)
+    bool irradiance_fields = true;  // beyond the paper: a surface with a textured reflectance
+                                    //   stores H (B = E + rho H, radiosity_view.h)
+    bool ambient = true;            // beyond the paper: at the end, the power still unshot is
+                                    //   sent on through the measured coupling of the surfaces
+                                    //   (the fraction of each shooter's power each receiver got,
+                                    //   over all its shots) and added as a constant radiosity per
+                                    //   surface (Cohen et al. 1988's ambient term, with measured
+                                    //   instead of area-weighted coupling)
 };
 
 /// The scene's `set` statements as solver options (shadows: the scene's method and rays).
@@ -101,14 +104,24 @@ struct SolveStats {
     std::vector<ShotStats> per_shot;
 };
 
-/// A solved scene: per surface (in scene order) its radiosity B (emission included) and what is
-/// still unshot, and the union of the receiver quadtrees each surface was given (leaves).
+/// A solved scene: per surface (in scene order) its field, what it holds (quantity: B with the
+/// emission included, or H for a textured reflectance, B = E + rho H; radiosity_view() forms
+/// B either way), what is still unshot (always B), and the union of the receiver quadtrees each
+/// surface was given (leaves).
 struct Solution {
     std::vector<SplineField> radiosity;
+    std::vector<FieldQuantity> quantity;  // per surface; empty means every field holds B
     std::vector<SplineField> unshot;
     std::vector<std::vector<DyadicCell>> leaves;
     SolveStats stats;
 };
+
+/// B_i(u, v) of every surface of a solution of `scene` (both must outlive the view).
+RadiosityView radiosity_view(const Scene& scene, const Solution& solution);
+
+/// True when surface i of `scene` stores H under `options` (a textured reflectance with
+/// irradiance_fields on).
+bool stores_irradiance(const Scene& scene, int surface, const SolverOptions& options);
 
 /// The progressive loop, one shot at a time (for progress reports and tests).
 class ProgressiveSolver {
@@ -152,10 +165,12 @@ private:
     std::vector<HiddenMask> hidden_;    // per surface (empty masks when the option is off)
     std::vector<double> last_seconds_;  // per surface: its last transfer's seconds (scheduling)
     Rgb power(int surface, const SplineField& field) const;
+    /// The unshot increment of an irradiance receiver: the L2 projection of rho dH (eq. (2)).
+    SplineField reflected_field(int surface, const SplineField& dH) const;
 
     /// What one receiver got from a shot: dB_i, its transfer's counts, the cells its tree split.
     struct Received {
-        SplineField field;
+        SplineField field;  // dB_i, or dH_i for an irradiance receiver
         TransferStats stats;
         std::vector<std::uint64_t> splits;
     };
@@ -182,6 +197,8 @@ Solution solve(const Scene& scene, const Octree& octree, const SolverOptions& op
 /// the L2 projection at `level` (Gauss-Legendre quadrature of the texture against the basis,
 /// then the Gram solve of math/wavelet.h's kind).
 SplineField project_emission(const Texture& emission, int m, int level);
+/// The L2([0,1]^2) projection of f onto the order-m basis of `level` (the same rule).
+SplineField l2_projection(const std::function<Rgb(double, double)>& f, int m, int level);
 
 }  // namespace mbr
 
