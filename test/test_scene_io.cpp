@@ -874,7 +874,13 @@ TEST_CASE("scene_io: messages print numbers that read back as themselves", "[sce
 }
 
 TEST_CASE("scene_io: OBJ group names never collide", "[scene_io][obj]") {
-    const std::string v4 = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n";
+    // Four unit squares side by side: faces 1 2 3 4, 5 6 7 8, 9 10 11 12 and 13 14 15 16 (one
+    // face written twice would be dropped as a repeat, docs/scene-format.md).
+    const std::string v4 =
+        "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
+        "v 2 0 0\nv 3 0 0\nv 3 1 0\nv 2 1 0\n"
+        "v 4 0 0\nv 5 0 0\nv 5 1 0\nv 4 1 0\n"
+        "v 6 0 0\nv 7 0 0\nv 7 1 0\nv 6 1 0\n";
     auto names = [&](const std::string& groups) {
         std::vector<std::string> out;
         for (const SceneSurface& s : parse_obj_text(v4 + groups).surfaces) out.push_back(s.name);
@@ -883,17 +889,17 @@ TEST_CASE("scene_io: OBJ group names never collide", "[scene_io][obj]") {
     using V = std::vector<std::string>;
     // A group 'a' of two faces and a group named 'a.0': the numbering skips the taken 'a.0',
     // whichever comes first in the file.
-    CHECK(names("g a\nf 1 2 3 4\nf 1 2 3 4\ng a.0\nf 1 2 3 4\n") == V{"a.1", "a.2", "a.0"});
-    CHECK(names("g a.0\nf 1 2 3 4\ng a\nf 1 2 3 4\nf 1 2 3 4\n") == V{"a.0", "a.1", "a.2"});
+    CHECK(names("g a\nf 1 2 3 4\nf 5 6 7 8\ng a.0\nf 9 10 11 12\n") == V{"a.1", "a.2", "a.0"});
+    CHECK(names("g a.0\nf 1 2 3 4\ng a\nf 5 6 7 8\nf 9 10 11 12\n") == V{"a.0", "a.1", "a.2"});
     // A group 'a.1' of several faces is numbered in its own right; 'a' may then use 'a.1'.
-    CHECK(names("g a\nf 1 2 3 4\nf 1 2 3 4\ng a.1\nf 1 2 3 4\nf 1 2 3 4\n") ==
+    CHECK(names("g a\nf 1 2 3 4\nf 5 6 7 8\ng a.1\nf 9 10 11 12\nf 13 14 15 16\n") ==
           V{"a.0", "a.1", "a.1.0", "a.1.1"});
     // A triangle is three surfaces of its group; the file's stem names faces without a group.
     CHECK(names("f 1 2 3\ng inline.1\nf 1 2 3 4\n") ==
           V{"inline.0", "inline.2", "inline.3", "inline.1"});
     // And the unique names go through an `obj` statement into a scene without complaint.
     TempDir dir;
-    dir.write("g.obj", v4 + "g a\nf 1 2 3 4\nf 1 2 3 4\ng a.0\nf 1 2 3 4\n");
+    dir.write("g.obj", v4 + "g a\nf 1 2 3 4\nf 5 6 7 8\ng a.0\nf 9 10 11 12\n");
     CHECK(load_scene(dir.write("g.scene", "obj g.obj\n")).surfaces.size() == 3);
 }
 
@@ -919,8 +925,10 @@ TEST_CASE("scene_io: the scene records every file its readers opened, in order",
                                std::filesystem::copy_options::overwrite_existing);
     const std::string p = dir.path.string() + "/";
     dir.write("t.mtl", "newmtl poster\nKd 0.5 0.5 0.5\nmap_Kd b.png\n");
+    // The OBJ's quad lies above the rectangle r (the same place with another material would be
+    // an error, docs/scene-format.md).
     dir.write("t.obj",
-              "mtllib t.mtl\nusemtl poster\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
+              "mtllib t.mtl\nusemtl poster\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n"
               "f 1 2 3 4\n");
     dir.write("inc.scene", "material c reflectance image a.png\n");
     const std::string top = dir.write("top.scene",
@@ -946,8 +954,10 @@ TEST_CASE("scene_io: an image named by several materials is decoded once", "[sce
     std::filesystem::copy_file(scenes_dir + "picture.png", dir.path / "big.png");
     std::filesystem::create_directories(dir.path / "sub");
     dir.write("t.mtl", "newmtl poster\nKd 0.5 0.5 0.5\nmap_Kd big.png\n");
+    // The OBJ's quad lies above the rectangle r (the same place with another material would be
+    // an error, docs/scene-format.md).
     dir.write("t.obj",
-              "mtllib t.mtl\nusemtl poster\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
+              "mtllib t.mtl\nusemtl poster\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n"
               "f 1 2 3 4\n");
     const std::string text =
         "material a reflectance image big.png\n"

@@ -88,8 +88,11 @@ std::string describe_run(const SceneRun& run) {
            std::to_string(run.scene.settings.tessellation) + ")";
 }
 
-/// The scene's settings, then the command line over them; threads; the octree.
+/// The scene's warnings; the scene's settings, then the command line over them; threads; the
+/// octree.
 void finish_scene_run(const SolverArgs& a, SceneRun& run) {
+    // Once per run, before anything else can fail: what the readers let pass is said first.
+    print_scene_warnings(std::cerr, run.scene);
     SolverSettings s = run.scene.settings;
     for (const SolverArgs::Given& g : a.given) apply_flag(s, g.option, g.flag, g.value);
     if (s.min_depth > s.max_depth) {
@@ -129,6 +132,10 @@ void finish_scene_run(const SolverArgs& a, SceneRun& run) {
 }
 
 }  // namespace
+
+void print_scene_warnings(std::ostream& os, const Scene& scene) {
+    for (const SceneWarning& w : scene.warnings) os << "warning: " << w.text() << "\n";
+}
 
 void check_render_cost(const SceneRun& run, const RenderOptions& options) {
     const Camera& camera = run.scene.camera;

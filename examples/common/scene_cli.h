@@ -38,15 +38,21 @@ struct SceneRun {
 /// exceeds the run's memory budget.
 void check_render_cost(const SceneRun& run, const RenderOptions& options);
 
+/// The readers' warnings (Scene::warnings), one line each: "warning: " + SceneWarning::text().
+/// read_scene_run prints them on stderr once, right after loading, with --quiet too: they are
+/// about the input, not progress.
+void print_scene_warnings(std::ostream& os, const Scene& scene);
+
 /// Reads the solver options (every flag of the option table, radiosity/scene/settings.h, with
 /// its aliases such as --shots and --rays; --threads, --quiet, --memory-budget), then the scene
 /// path (the one positional argument, or `default_scene` when empty and none is given), loads
-/// the scene and builds its octree. The flags override the scene's `set` lines (and are written
-/// into run.scene.settings). Call it after reading the program's own options.
+/// the scene (printing its warnings, print_scene_warnings) and builds its octree. The flags
+/// override the scene's `set` lines (and are written into run.scene.settings). Call it after
+/// reading the program's own options.
 SceneRun read_scene_run(Args& args, const std::string& default_scene);
 /// The same for a scene made by the program: the options of solver_options_usage() without SCENE
-/// (a positional argument is refused), applied over the scene's settings; `name` stands for the
-/// path in summaries.
+/// (a positional argument is refused), applied over the scene's settings, and the scene's
+/// warnings printed; `name` stands for the path in summaries.
 SceneRun read_scene_run(Args& args, Scene scene, const std::string& name);
 
 /// Solves, with a progress bar on stderr when it is a terminal and `progress` is set.

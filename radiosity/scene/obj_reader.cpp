@@ -9,6 +9,7 @@
 #include <unordered_set>
 
 #include "math/check.h"
+#include "radiosity/scene/duplicate_faces.h"
 #include "radiosity/scene/faces_to_quads.h"
 
 namespace mbr {
@@ -36,6 +37,7 @@ public:
     ObjReader(std::string name, LoadState& state) : name_(std::move(name)), state_(state) {
         group_ = fs::path(name_).stem().string();
         if (group_.empty()) group_ = "obj";
+        scene_.sources = {name_};  // every surface's statement is in this file
     }
 
     Scene read(std::istream& in) {
@@ -151,6 +153,8 @@ private:
             s.name = group_;
             s.surface = Surface::planar_quad(q[0], q[1], q[2], q[3]);
             s.material = material_;
+            s.source = 0;
+            s.line = line.number;
             scene_.surfaces.push_back(std::move(s));
         }
     }
@@ -346,9 +350,13 @@ Scene read_obj(std::istream& in, const std::string& name, LoadState& state) {
 
 }  // namespace detail
 
+// An OBJ file read on its own is checked for repeated faces here; imported into a scene, by the
+// scene reader, with the scene's other surfaces.
 Scene parse_obj(std::istream& in, const std::string& name) {
     LoadState state;
-    return read_obj(in, name, state);
+    Scene scene = read_obj(in, name, state);
+    drop_duplicate_surfaces(scene);
+    return scene;
 }
 
 Scene load_obj(const std::string& path) {
@@ -356,7 +364,9 @@ Scene load_obj(const std::string& path) {
     open_top(path, in);
     LoadState state;
     state.record(path);
-    return read_obj(in, path, state);
+    Scene scene = read_obj(in, path, state);
+    drop_duplicate_surfaces(scene);
+    return scene;
 }
 
 }  // namespace mbr

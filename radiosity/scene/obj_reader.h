@@ -15,7 +15,9 @@ namespace mbr {
 
 /// Imports a Wavefront OBJ file and the MTL libraries it names (docs/scene-format.md, "OBJ
 /// import"): Kd -> reflectance, Ke (emitted radiance) -> emission E = pi Ke, every face ->
-/// one or more planar quads. The scene has no camera and default settings. Throws InputError.
+/// one or more planar quads. A face that repeats another (same corners, same front side) is
+/// dropped with a warning in Scene::warnings, or refused when its material differs
+/// (duplicate_faces.h). The scene has no camera and default settings. Throws InputError.
 Scene load_obj(const std::string& path);
 
 /// Parses OBJ text from a stream; `name` is used in messages and to resolve `mtllib` paths.
@@ -51,7 +53,8 @@ private:
     std::unordered_map<std::string, Texture> textures_;  // canonical path -> decoded image
 };
 
-/// Reads OBJ text named `name` as part of the load `state` (parse_obj with a shared state).
+/// Reads OBJ text named `name` as part of the load `state` (parse_obj with a shared state),
+/// without the check for repeated faces, which the caller runs once on the whole scene.
 Scene read_obj(std::istream& in, const std::string& name, LoadState& state);
 
 }  // namespace detail

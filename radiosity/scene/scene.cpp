@@ -49,4 +49,28 @@ Box3 Scene::bounds() const {
     return box;
 }
 
+std::string Scene::where(int surface) const {
+    MBR_CHECK_MSG(surface >= 0 && size_t(surface) < surfaces.size(), "surface " << surface);
+    const SceneSurface& s = surfaces[size_t(surface)];
+    if (s.source < 0 || size_t(s.source) >= sources.size()) return "'" + s.name + "'";
+    return sources[size_t(s.source)] + ":" + std::to_string(s.line);
+}
+
+void Scene::warn(const SceneWarning& w) {
+    for (SceneWarning& x : warnings)
+        if (x.kind == w.kind) {
+            x.count += w.count;
+            return;
+        }
+    warnings.push_back(w);
+}
+
+std::string SceneWarning::text() const {
+    std::string s;
+    if (!file.empty()) s = file + (line > 0 ? ":" + std::to_string(line) : std::string()) + ": ";
+    s += message;
+    if (count > 1) s += " (and " + std::to_string(count - 1) + " more like it)";
+    return s;
+}
+
 }  // namespace mbr

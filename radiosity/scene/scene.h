@@ -30,11 +30,30 @@ struct Material {
     bool emits() const { return max_abs(emission.maximum()) > 0; }
 };
 
-/// One surface of the scene and the index of its material in Scene::materials.
+/// One surface of the scene, the index of its material in Scene::materials and where its
+/// statement is (Scene::where): the readers set source and line; a surface made in code has -1
+/// and 0.
 struct SceneSurface {
     std::string name;
     Surface surface;
     int material = -1;
+    int source = -1;  // index into Scene::sources: the file of its statement
+    int line = 0;     // the statement's line there (1-based)
+};
+
+/// Something the readers accepted but the user should hear of (a repeated surface they
+/// dropped, say). A load keeps one warning per kind: the first instance's place and message,
+/// and how many instances there were (Scene::warn). The programs print them once after loading,
+/// each as "warning: " + text().
+struct SceneWarning {
+    std::string kind;     // a short fixed phrase naming the kind ("duplicate surface")
+    std::string file;     // the first instance's file ("" when none)
+    int line = 0;         // and its line (0: the file as a whole)
+    std::string message;  // the first instance, in the input's terms
+    long count = 1;       // instances of this kind in the load
+
+    /// "FILE:LINE: MESSAGE", with " (and N more like it)" when count > 1.
+    std::string text() const;
 };
 
 /// A pinhole camera. A right-handed frame: the image's right is (look_at - eye) x up.
@@ -58,6 +77,12 @@ struct Scene {
     /// the scene or OBJ file itself (when loaded from a file), includes, OBJ files, MTL
     /// libraries and texture images (each image once, however many materials name it).
     std::vector<std::string> input_files;
+    /// The files that surface statements came from (SceneSurface::source), each once: the
+    /// scene file, includes and OBJ files, as the readers named them (a parsed stream by its
+    /// name).
+    std::vector<std::string> sources;
+    /// What the readers accepted with a warning, one per kind, in the order first met.
+    std::vector<SceneWarning> warnings;
 
     /// Index of the material called `name`, or -1.
     int find_material(const std::string& name) const;
@@ -74,6 +99,11 @@ struct Scene {
     Rgb emitted_power() const;
     /// A box containing every surface (empty when there are none).
     Box3 bounds() const;
+    /// "FILE:LINE" of surface i's statement, or its name in quotes when it was made in code.
+    std::string where(int surface) const;
+    /// Records a warning: a new kind is appended; a kind already recorded keeps its first
+    /// instance and adds w.count to its count.
+    void warn(const SceneWarning& w);
 };
 
 }  // namespace mbr

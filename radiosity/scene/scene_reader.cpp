@@ -11,6 +11,7 @@
 #include <unordered_map>
 
 #include "math/check.h"
+#include "radiosity/scene/duplicate_faces.h"
 #include "radiosity/scene/faces_to_quads.h"
 #include "radiosity/scene/line_reader.h"
 #include "radiosity/scene/obj_reader.h"
@@ -139,11 +140,21 @@ public:
             at.fail("min_depth " + std::to_string(s.min_depth) + " exceeds max_depth " +
                     std::to_string(s.max_depth));
         }
+        // Every surface is in now, from this file, its includes and its OBJ imports: repeats are
+        // found across all of them (duplicate_faces.h).
+        drop_duplicate_surfaces(scene_);
         scene_.input_files = state_.files();
         return std::move(scene_);
     }
 
 private:
+    /// The index of `file` in Scene::sources, added when new.
+    int source(const std::string& file) {
+        auto [it, is_new] = source_index_.try_emplace(file, int(scene_.sources.size()));
+        if (is_new) scene_.sources.push_back(file);
+        return it->second;
+    }
+
     void read_file(std::istream& in, const std::string& name, int depth) {
         stack_.push_back(canonical_name(name));
         LineReader reader(in, name);
@@ -275,7 +286,7 @@ private:
         if (!is_new)
             line.fail("duplicate surface name " + in_quotes(name) + " (first used at " +
                       seen->second + ")");
-        scene_.surfaces.push_back({name, std::move(s), material});
+        scene_.surfaces.push_back({name, std::move(s), material, source(line.file), line.number});
     }
 
     Surface checked_quad(const Line& line, const Quad& q) {
@@ -546,12 +557,14 @@ private:
         }
         for (SceneSurface& s : part.surfaces) {
             s.material = index[size_t(s.material)];
+            if (s.source >= 0) s.source = source(part.sources[size_t(s.source)]);
             auto [seen, is_new] = surface_where_.try_emplace(s.name, path);
             if (!is_new)
                 line.fail("surface " + in_quotes(s.name) + " of " + in_quotes(path) +
                           " has the name of an earlier surface (at " + seen->second + ")");
             scene_.surfaces.push_back(std::move(s));
         }
+        for (const SceneWarning& w : part.warnings) scene_.warn(w);
     }
 
     void include(const Line& line, int depth) {
@@ -590,6 +603,7 @@ private:
     // Name look-ups in constant time: a scene of n surfaces is read in O(n), not O(n^2).
     std::unordered_map<std::string, MaterialEntry> materials_;
     std::unordered_map<std::string, std::string> surface_where_;  // name -> "file:line"
+    std::unordered_map<std::string, int> source_index_;           // file -> Scene::sources
     std::set<std::string> settings_seen_;
     int camera_line_ = 0;
     Line depth_line_;

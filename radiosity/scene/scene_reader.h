@@ -12,7 +12,9 @@
 namespace mbr {
 
 /// Reads a scene file (docs/scene-format.md). Relative paths inside it (textures, `obj`,
-/// `include`) are relative to the file's folder. Throws InputError.
+/// `include`) are relative to the file's folder. A surface that repeats another (its file,
+/// includes and OBJ imports together) is dropped with a warning in Scene::warnings, or refused
+/// when its material differs (duplicate_faces.h). Throws InputError.
 Scene load_scene(const std::string& path);
 
 /// Parses scene text from a stream; `name` is used in messages and, through its folder, to
