@@ -4,6 +4,8 @@
 //
 //   mbr render SCENE -o OUT.png [options]     solve (or load) and render to PNG (and HDR)
 //   mbr probe SCENE --points FILE.csv         solve (or load), then B at the points, as CSV
+//     both with --light-group NAME=WEIGHT ... [--group-solutions PREFIX]: relighting, the
+//     weighted sum of each light group's solution (radiosity/solver/superposition.h)
 //   mbr reference SCENE --points FILE.csv --paths N   path-traced B at the points
 //   mbr tables                                Tables 1, 2 and 3 beside the paper's values
 //   mbr --help | mbr COMMAND --help | mbr --version
@@ -13,7 +15,10 @@
 // failure while running; one line on stderr. The outputs of a run are written all or none
 // (write_files, radiosity/output/output_file.h).
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
+#include <cinttypes>
+#include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <iostream>
@@ -30,6 +35,7 @@
 #include "radiosity/output/output_file.h"
 #include "radiosity/output/render.h"
 #include "radiosity/reference/probe.h"
+#include "radiosity/solver/superposition.h"
 
 #ifndef MBR_VERSION
 #define MBR_VERSION "unknown"
@@ -43,13 +49,41 @@ const char* main_usage =
     "  Multiresolution B-spline radiosity (Yu and Peng): radiosity as tensor B-splines of\n"
     "  several scales, solved by progressive refinement with shadows.\n"
     "commands:\n"
-    "  render SCENE -o OUT.png     solve the scene (or load a solution) and render it\n"
+    "  render SCENE -o OUT.png     solve the scene (or load a solution) and render it;\n"
+    "    --light-group NAME=WEIGHT ... [--group-solutions PREFIX]: relight, a weighted sum\n"
+    "    of the light groups' solutions, without solving again (mbr render --help)\n"
     "  probe SCENE --points F.csv  solve (or load), then print B at the given world points\n"
     "  reference SCENE --points F.csv --paths N\n"
     "                              an independent path-traced estimate at those points\n"
     "  tables                      the paper's Tables 1, 2 and 3, computed now, beside its values\n"
     "  --help, COMMAND --help      usage; --version: the version\n"
     "Scene files: docs/scene-format.md. Exit status 0 ok, 2 bad usage or input, 1 failure.\n";
+
+/// Usage lines of the light-group options (render and, without saving, probe).
+std::string light_group_usage(bool render) {
+    std::string u =
+        "light groups (relighting by superposition; docs/solution-format.md, \"Light groups\"):\n"
+        "  A light group is an emitting material and every surface made of it. A group's\n"
+        "  solution is the scene solved with every other group's emission off (reflectance\n"
+        "  kept). The result is the weighted sum of the groups' solutions: the solve of the\n"
+        "  scene with each group's emission times its weight, to the solves' tolerance.\n"
+        "  --light-group NAME=WEIGHT group NAME's weight, finite and >= 0 (0 turns it off, 2\n"
+        "                            doubles it); repeat it for several groups (or give\n"
+        "                            several, blank-separated, in one argument); a group not\n"
+        "                            named keeps weight 1\n"
+        "  --group-solutions PREFIX  read group NAME's solution from the file PREFIX + NAME +\n"
+        "                            .solution instead of solving (no solve at all)\n";
+    if (render)
+        u += "  --save-group-solutions PREFIX\n"
+             "                            solve each group and write its solution to PREFIX +\n"
+             "                            NAME + .solution, with the image (all or none)\n";
+    u += render ? "  Without --group-solutions, every group is solved now, one after the other.\n"
+                : "  Without --group-solutions, every group is solved now, one after the other\n"
+                  "  (mbr render --save-group-solutions keeps them).\n";
+    u += "  In file names, bytes of NAME other than letters, digits, . _ - + = , @ and\n"
+         "  non-ASCII bytes are written %XX.\n";
+    return u;
+}
 
 std::string render_usage() {
     return std::string(
@@ -64,7 +98,7 @@ std::string render_usage() {
                "  --save-solution F         write the solved fields to F\n"
                "  --load-solution F         render F's fields instead of solving\n"
                "  --seed n                  seed of the pixel jitter (default 1)\n") +
-           solver_options_usage();
+           light_group_usage(true) + solver_options_usage();
 }
 
 std::string probe_usage() {
@@ -78,7 +112,7 @@ std::string probe_usage() {
                "                            Each point goes to the nearest surface point within\n"
                "                            1e-3 of the scene's bounding-box diagonal.\n"
                "  --load-solution F         use F's fields instead of solving\n") +
-           solver_options_usage();
+           light_group_usage(false) + solver_options_usage();
 }
 
 /// A solution: solved now (printing the summary unless quiet), or loaded.
@@ -104,6 +138,226 @@ std::vector<std::string> run_inputs(const SceneRun& run, const std::string& load
     return inputs;
 }
 
+// ---- Light groups: relighting by superposition (radiosity/solver/superposition.h) ----------
+
+/// The light-group options as given on the command line.
+struct GroupArgs {
+    std::vector<std::string> weights;  // the NAME=WEIGHT words of --light-group
+    bool load = false;                 // --group-solutions PREFIX
+    std::string load_prefix;
+    bool save = false;  // --save-group-solutions PREFIX (render only)
+    std::string save_prefix;
+    bool on() const { return !weights.empty() || load || save; }
+};
+
+GroupArgs read_group_args(Args& args, bool render) {
+    GroupArgs a;
+    if (args.has("--light-group")) {
+        // main() has joined every --light-group of the line into one, blank-separated.
+        std::istringstream words(args.text("--light-group", ""));
+        for (std::string w; words >> w;) a.weights.push_back(w);
+        if (a.weights.empty()) throw UsageError("--light-group expects NAME=WEIGHT");
+    }
+    a.load = args.has("--group-solutions");
+    a.load_prefix = args.text("--group-solutions", "");
+    if (render) {
+        a.save = args.has("--save-group-solutions");
+        a.save_prefix = args.text("--save-group-solutions", "");
+    }
+    if (a.load && a.save)
+        throw UsageError(
+            "--group-solutions and --save-group-solutions exclude each other (the first reads "
+            "the groups' solutions, the second solves the groups and writes them)");
+    return a;
+}
+
+/// A group's name as part of a file name: letters, digits, . _ - + = , @ and non-ASCII bytes as
+/// they are, every other byte (a '/', a '%', a control byte) as %XX.
+std::string file_name_part(const std::string& name) {
+    std::string out;
+    for (unsigned char c : name) {
+        if (std::isalnum(c) || c >= 0x80 || (c != 0 && std::strchr("._-+=,@", c) != nullptr)) {
+            out += char(c);
+        } else {
+            char hex[4];
+            std::snprintf(hex, sizeof hex, "%%%02X", unsigned(c));
+            out += hex;
+        }
+    }
+    return out;
+}
+
+/// What the light-group options ask of the scene: its groups with their weights and files.
+struct GroupPlan {
+    std::vector<LightGroup> groups;
+    std::vector<double> weights;    // per group: its --light-group weight, else 1
+    std::vector<std::string> load;  // per group: the solution file to read, or empty: solve
+    std::vector<std::string> save;  // per group: the solution file to write, or empty
+};
+
+/// Why `name` is no light group of the scene, with the names of those it has.
+std::string no_such_group(const SceneRun& run, const std::string& name,
+                          const std::vector<LightGroup>& groups) {
+    const int m = run.scene.find_material(name);
+    std::string why =
+        m < 0 ? "unknown light group '" + name + "'"
+        : !run.scene.materials[size_t(m)].emits()
+            ? "material '" + name + "' emits nothing, so it is no light group"
+            : "material '" + name + "' is used by no surface, so it is no light group";
+    std::string list;
+    const size_t shown = std::min<size_t>(groups.size(), 20);
+    for (size_t g = 0; g < shown; ++g) list += (g ? ", " : "") + groups[g].name;
+    if (groups.size() > shown) list += " and " + std::to_string(groups.size() - shown) + " more";
+    return why + ": the light groups of " + run.path + " (its emitting materials) are " + list;
+}
+
+GroupPlan plan_groups(const GroupArgs& a, const SceneRun& run) {
+    GroupPlan p;
+    p.groups = light_groups(run.scene);
+    if (p.groups.empty())
+        throw UsageError(
+            run.path + " has no light group: no surface is made of an emitting material", false);
+    const size_t n = p.groups.size();
+    p.weights.assign(n, 1.0);
+    std::vector<std::string> given(n);
+    for (const std::string& word : a.weights) {
+        const size_t eq = word.rfind('=');  // a name may hold '=', a number never does
+        if (eq == std::string::npos || eq == 0 || eq + 1 == word.size())
+            throw UsageError("--light-group expects NAME=WEIGHT, got '" + word + "'");
+        const std::string name = word.substr(0, eq), value = word.substr(eq + 1);
+        size_t g = 0;
+        while (g < n && p.groups[g].name != name) ++g;
+        if (g == n) throw UsageError(no_such_group(run, name, p.groups), false);
+        if (!given[g].empty())
+            throw UsageError("light group '" + name + "' is given twice (" + given[g] + " and " +
+                             word + ")");
+        given[g] = word;
+        const double w = parse_number(value, "--light-group " + name);
+        if (!(w >= 0))
+            throw UsageError("--light-group " + name + ": the weight must be >= 0, got '" + value +
+                             "'");
+        const Material& mat = run.scene.materials[size_t(p.groups[g].material)];
+        if (w * max_abs(mat.emission.maximum()) > max_emission)
+            throw UsageError("--light-group " + word + " makes the emission " +
+                             cell_g(w * max_abs(mat.emission.maximum()), 6) +
+                             ", beyond the scene format's limit of 1e30");
+        p.weights[g] = w;
+    }
+    p.load.resize(n);
+    p.save.resize(n);
+    for (size_t g = 0; g < n; ++g) {
+        const std::string file = file_name_part(p.groups[g].name) + ".solution";
+        if (a.load) p.load[g] = a.load_prefix + file;
+        if (a.save) p.save[g] = a.save_prefix + file;
+    }
+    return p;
+}
+
+/// The fingerprint of `scene` as a solution file's second line writes it.
+std::string fingerprint_text(const Scene& scene) {
+    char fp[32];
+    std::snprintf(fp, sizeof fp, "%016" PRIx64, scene_fingerprint(scene));
+    return fp;
+}
+
+/// Group g's solution from plan.load[g], for the group's scene. A file that is another group's
+/// solution, or the whole scene's, is refused by that name rather than as another scene's.
+Solution load_group_solution(const SceneRun& run, const GroupPlan& plan, size_t g,
+                             const Scene& group_scene) {
+    const std::string& path = plan.load[g];
+    try {
+        return load_solution(path, group_scene);  // refuses folders, devices and FIFOs
+    } catch (const InputError& e) {
+        if (e.line() != 2 || e.message().rfind("the solution was made for another scene", 0) != 0)
+            throw;
+        // The first two lines have been read and checked: "mbr-solution 1", "fingerprint H".
+        std::ifstream in(path);
+        std::string header, word, fp;
+        std::getline(in, header);
+        in >> word >> fp;
+        for (size_t h = 0; h < plan.groups.size(); ++h)
+            if (h != g && fp == fingerprint_text(light_group_scene(run.scene, plan.groups, int(h))))
+                throw InputError(path, 2,
+                                 "this is the solution of light group '" + plan.groups[h].name +
+                                     "', not of light group '" + plan.groups[g].name + "'");
+        if (fp == fingerprint_text(run.scene))
+            throw InputError(path, 2,
+                             "this is the solution of the whole scene (every light, as "
+                             "--save-solution writes it), not of light group '" +
+                                 plan.groups[g].name + "'");
+        throw;
+    }
+}
+
+/// Each group's solution, read (plan.load) or solved now, and their weighted sum
+/// (radiosity/solver/superposition.h). The group solutions to save are added to `files`.
+Solution relight(SceneRun& run, const GroupPlan& plan, bool report, std::ostream& summary,
+                 std::vector<OutputFile>& files) {
+    std::vector<Solution> solutions;
+    solutions.reserve(plan.groups.size());
+    for (size_t g = 0; g < plan.groups.size(); ++g) {
+        const std::string& name = plan.groups[g].name;
+        Scene group_scene = light_group_scene(run.scene, plan.groups, int(g));
+        if (!plan.load[g].empty()) {
+            solutions.push_back(load_group_solution(run, plan, g, group_scene));
+            // The fields of one sum must share the order (the levels may differ).
+            const int m =
+                solutions.back().radiosity.empty() ? 0 : solutions.back().radiosity[0].order();
+            const int m0 = solutions[0].radiosity.empty() ? 0 : solutions[0].radiosity[0].order();
+            if (m != m0)
+                throw InputError(plan.load[g], 3,
+                                 "the fields are of order " + std::to_string(m) + ", those of " +
+                                     plan.load[0] + " of order " + std::to_string(m0) +
+                                     ": solve every light group with the same order");
+            // And each surface's field must hold the same quantity (B, or H: `set texture_field`).
+            for (size_t i = 0; i < run.scene.surfaces.size(); ++i) {
+                const auto holds = [i](const Solution& s) {
+                    const bool h =
+                        i < s.quantity.size() && s.quantity[i] == FieldQuantity::irradiance;
+                    return std::string(h ? "the irradiance H" : "the radiosity B");
+                };
+                if (holds(solutions.back()) != holds(solutions[0]))
+                    throw InputError(plan.load[g], 0,
+                                     "surface '" + run.scene.surfaces[i].name + "' holds " +
+                                         holds(solutions.back()) + " here and " +
+                                         holds(solutions[0]) + " in " + plan.load[0] +
+                                         ": solve every light group with the same texture_field");
+            }
+            if (report) summary << "loaded " << plan.load[g] << " (light group " << name << ")\n";
+        } else {
+            // The group's solve: the run's scene is the group's while it runs (the surfaces are
+            // the same, so the octree and the options hold).
+            std::swap(run.scene, group_scene);
+            solutions.push_back(solve_scene(run, true));
+            std::swap(run.scene, group_scene);
+            if (report) {
+                summary << "light group " << name << " alone:\n";
+                print_summary(summary, run, solutions.back().stats);
+            }
+        }
+        if (!plan.save[g].empty()) {
+            // Written with the images, all or none (radiosity/output/output_file.h).
+            std::ostringstream os;
+            save_solution(os, group_scene, solutions.back());
+            MBR_CHECK_MSG(!os.fail(),
+                          "the solution of " << plan.save[g] << " could not be formatted");
+            files.push_back({plan.save[g], os.str()});
+            if (report) summary << "wrote " << plan.save[g] << "\n";
+        }
+    }
+    std::vector<const Solution*> terms;
+    for (const Solution& s : solutions) terms.push_back(&s);
+    Solution sum = combine(terms, plan.weights);
+    if (report) {
+        summary << "relit:";
+        for (size_t g = 0; g < plan.groups.size(); ++g)
+            summary << (g ? ", " : " ") << plan.groups[g].name << " x "
+                    << cell_g(plan.weights[g], 6);
+        summary << "\n";
+    }
+    return sum;
+}
+
 int render_command(Args& args) {
     const std::string out = args.text("-o", "");
     const int spp = args.integer("--spp", 4, 1, 4096);
@@ -113,17 +367,29 @@ int render_command(Args& args) {
     const std::string save = args.text("--save-solution", "");
     const std::string load = args.text("--load-solution", "");
     const int seed = args.integer("--seed", 1, 0, 2147483647);
+    const GroupArgs group_args = read_group_args(args, true);
     if (out.empty()) throw UsageError("-o OUT.png is required");
     if (!save.empty() && !load.empty())
         throw UsageError("--save-solution and --load-solution exclude each other");
+    if (group_args.on() && (args.has("--save-solution") || args.has("--load-solution")))
+        throw UsageError(
+            "--save-solution and --load-solution hold the whole scene's solution; with light "
+            "groups use --save-group-solutions and --group-solutions");
     if (!(exposure > 0)) throw UsageError("--exposure must be positive");
     // Refuse outputs that cannot be written, or that clash, before any work; the scene's own
-    // files are known once it is read (and before it is solved).
-    const std::vector<std::string> outputs{out, hdr, save};
+    // files, and the light groups' files, are known once it is read (and before it is solved).
+    std::vector<std::string> outputs{out, hdr, save};
     refuse_bad_outputs(outputs, {load});
     SceneRun run = read_scene_run(args, "");
     args.finish();
-    refuse_bad_outputs(outputs, run_inputs(run, load));
+    std::vector<std::string> inputs = run_inputs(run, load);
+    GroupPlan plan;
+    if (group_args.on()) {
+        plan = plan_groups(group_args, run);
+        outputs.insert(outputs.end(), plan.save.begin(), plan.save.end());
+        inputs.insert(inputs.end(), plan.load.begin(), plan.load.end());
+    }
+    refuse_bad_outputs(outputs, inputs);
     if (!run.scene.has_camera)
         throw InputError(run.path, 0, "the scene has no camera statement: nothing to render from");
     RenderOptions ro;
@@ -135,8 +401,15 @@ int render_command(Args& args) {
 
     const bool report = !is_standard_output(out) && !is_standard_output(hdr);
     std::ostringstream summary;
-    const Solution solution = obtain_solution(run, load, report, summary);
     std::vector<OutputFile> files;
+    const Solution solution = group_args.on() ? relight(run, plan, report, summary, files)
+                                              : obtain_solution(run, load, report, summary);
+    // DESIGN: a relit image is drawn with the scene whose groups' emissions are multiplied by
+    // their weights: the scene the weighted sum solves. A field that holds B has the weighted
+    // emission in it already; for one that holds H, radiosity_view adds E from this scene.
+    const Scene lit =
+        group_args.on() ? weighted_scene(run.scene, plan.groups, plan.weights) : Scene{};
+    const Scene& shown = group_args.on() ? lit : run.scene;
     if (!save.empty()) {
         // Written with the images, all or none (radiosity/output/output_file.h).
         std::ostringstream os;
@@ -146,10 +419,10 @@ int render_command(Args& args) {
         if (report) summary << "wrote " << save << "\n";
     }
     const double start = now_seconds();
-    const Image radiance = render_radiance(run.scene, *run.octree, radiosity_view(run.scene, solution), ro);
+    const Image radiance = render_radiance(shown, *run.octree, radiosity_view(shown, solution), ro);
     Image display = tone_map(radiance, exposure);
     if (quadtree)
-        draw_quadtree_overlay(display, run.scene, *run.octree, &solution.leaves, ro.overlay_colour);
+        draw_quadtree_overlay(display, shown, *run.octree, &solution.leaves, ro.overlay_colour);
     files.push_back({out, encode_png(display)});
     if (!hdr.empty()) {
         std::ostringstream os;
@@ -169,18 +442,30 @@ int render_command(Args& args) {
 int probe_command(Args& args) {
     const std::string points_path = args.text("--points", "");
     const std::string load = args.text("--load-solution", "");
+    const GroupArgs group_args = read_group_args(args, false);
     if (points_path.empty()) throw UsageError("--points FILE.csv is required");
+    if (group_args.on() && args.has("--load-solution"))
+        throw UsageError(
+            "--load-solution holds the whole scene's solution; with light groups use "
+            "--group-solutions");
     SceneRun run = read_scene_run(args, "");
     args.finish();
+    const GroupPlan plan = group_args.on() ? plan_groups(group_args, run) : GroupPlan{};
     // Read and place the points before solving: a bad file fails at once.
     const std::vector<ProbePoint> points = read_probe_points(points_path);
     const std::vector<SurfaceLocation> at = locate_probe_points(
         run.scene, run.octree->polygons(), points, points_path, probe_tolerance(run.scene));
     std::ostringstream ignored;
-    const Solution solution = obtain_solution(run, load, false, ignored);
+    std::vector<OutputFile> none;  // probe saves no group solutions
+    const Solution solution = group_args.on() ? relight(run, plan, false, ignored, none)
+                                              : obtain_solution(run, load, false, ignored);
+    // Relit: B is formed with the groups' emissions times their weights (see render_command).
+    const Scene lit =
+        group_args.on() ? weighted_scene(run.scene, plan.groups, plan.weights) : Scene{};
+    const Scene& shown = group_args.on() ? lit : run.scene;
     std::vector<std::string> names;
     std::vector<Rgb> values;
-    const RadiosityView view = radiosity_view(run.scene, solution);  // B = E + rho H for H fields
+    const RadiosityView view = radiosity_view(shown, solution);  // B = E + rho H for H fields
     for (size_t i = 0; i < points.size(); ++i) {
         names.push_back(points[i].name);
         values.push_back(view.at(at[i].surface, at[i].u, at[i].v));
@@ -197,6 +482,32 @@ int tables_command(Args& args) {
     std::cout << "\n== Table 3: dual coefficients mu_{3;0,l} ==\n";
     status = std::max(status, run_table3(args));
     return status;
+}
+
+/// Args reads each option once, but --light-group may be given many times: its values are
+/// joined into one "--light-group" value, blank-separated (names hold no blanks), before Args
+/// reads the line. One without a value (the last word, or before --help) is left for Args.
+std::vector<std::string> join_light_groups(const std::vector<std::string>& words) {
+    const std::string option = "--light-group";
+    std::vector<std::string> kept;
+    std::string joined;
+    bool any = false;
+    for (size_t i = 0; i < words.size(); ++i) {
+        const std::string& w = words[i];
+        const bool with_value =
+            w == option && i + 1 < words.size() && words[i + 1] != "--help" && words[i + 1] != "-h";
+        if (with_value || w.rfind(option + "=", 0) == 0) {
+            joined += (any ? " " : "") + (with_value ? words[++i] : w.substr(option.size() + 1));
+            any = true;
+        } else {
+            kept.push_back(w);
+        }
+    }
+    if (any) {
+        kept.push_back(option);
+        kept.push_back(joined);
+    }
+    return kept;
 }
 
 struct Command {
@@ -232,8 +543,10 @@ int main(int argc, char** argv) {
         if (first == c.name) {
             // The command's own arguments, with "mbr COMMAND" as the program name in messages.
             std::string program = std::string("mbr ") + c.name;
+            std::vector<std::string> words =
+                join_light_groups(std::vector<std::string>(argv + 2, argv + argc));
             std::vector<char*> sub{program.data()};
-            for (int i = 2; i < argc; ++i) sub.push_back(argv[i]);
+            for (std::string& w : words) sub.push_back(w.data());
             return run_main(static_cast<int>(sub.size()), sub.data(), c.usage, c.body);
         }
     if (first.empty()) {

@@ -56,6 +56,11 @@ std::vector<DyadicCell> union_of_leaves(const std::vector<const std::vector<Dyad
     return leaves;
 }
 
+/// What surface i's field holds in `s` (an empty list: B on every surface).
+FieldQuantity quantity_of(const Solution& s, size_t i) {
+    return i < s.quantity.size() ? s.quantity[i] : FieldQuantity::radiosity;
+}
+
 }  // namespace
 
 std::vector<LightGroup> light_groups(const Scene& scene) {
@@ -109,10 +114,16 @@ Solution combine(const std::vector<const Solution*>& solutions,
         MBR_CHECK_MSG(solutions[g]->radiosity.size() == n && solutions[g]->unshot.size() == n,
                       "solution " << g << " has " << solutions[g]->radiosity.size()
                                   << " surfaces, the first " << n);
+        // B and H fields do not add: a surface holds the same quantity in every solution.
+        for (size_t i = 0; i < n; ++i)
+            MBR_CHECK_MSG(quantity_of(*solutions[g], i) == quantity_of(*solutions[0], i),
+                          "surface " << i << " holds another quantity in solution " << g);
     }
     // DESIGN: the sum starts as a copy of the first solution, so that every per-surface member
-    // of Solution that is not a field (what a field holds, ...) is carried over as it is,
-    // including members added to Solution later; then the members that add are overwritten.
+    // of Solution that is not a field (quantity: what a field holds, ...) is carried over as it
+    // is, including members added to Solution later; then the members that add are overwritten.
+    // An H field adds as a B field does (H is linear in the emission too); its B = E + rho H
+    // takes E from the scene it is viewed with, weighted_scene for a relit sum.
     Solution out = *solutions[0];
     std::vector<const SplineField*> fields(solutions.size());
     std::vector<const std::vector<DyadicCell>*> trees;

@@ -47,13 +47,15 @@ Scene light_group_scene(const Scene& scene, const std::vector<LightGroup>& group
 /// (SplineField::add refines the coarser to the finer level by eq. (17); a zero weight adds
 /// nothing), the quadtree leaves the union of the trees of the solutions of positive weight (a
 /// cell is split when one of them split it). Every other per-surface member of Solution is
-/// copied from the first solution (the solutions are of one scene, so they agree). The run
+/// copied from the first solution (the solutions are of one scene, so they agree; each surface
+/// must hold the same FieldQuantity in all of them, an MBR_CHECK). The run
 /// statistics are the weighted sums of the powers (emitted, unshot, ambient), the sums of the
 /// counts (shots, seconds, kernel evaluations, rays), the largest peak memory, the coefficients of
 /// the sum, converged when every solution of positive weight converged, and no per-shot rows.
 /// Since each solution holds its group's emission times one, the sum holds each group's emission
 /// times its weight: the solution of weighted_scene(scene, groups, weights), up to the solves'
-/// tolerance.
+/// tolerance. View it with that scene (radiosity_view(weighted_scene(...), sum)): a surface that
+/// stores the irradiance H takes its emission E from the scene it is viewed with.
 Solution combine(const std::vector<const Solution*>& solutions, const std::vector<double>& weights);
 
 }  // namespace mbr
