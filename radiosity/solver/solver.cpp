@@ -163,6 +163,7 @@ SolverOptions solver_options(const SolverSettings& s) {
     o.self_transfer = s.self_transfer;
     o.tolerance = s.tolerance;
     o.ambient = s.ambient;
+    o.limiter = s.limiter;
     o.irradiance_fields = s.texture_field == TextureFieldSetting::Irradiance;
     o.hidden_regions = s.hidden;
     o.shooter_level = s.shooter_level;
@@ -236,6 +237,54 @@ SplineField project_emission(const Texture& emission, int m, int level) {
     if (emission.is_constant()) return SplineField::constant(m, 0, emission.value(0.5, 0.5));
     return l2_projection([&emission](double s, double t) { return emission.value(s, t); }, m,
                          level);
+}
+
+void limit_increment(SplineField& field, Rgb upper, double slack) {
+    if (field.empty()) return;
+    // Where the field leaves its bounds: at the corners, edge midpoints and centre of every
+    // level-j cell (2^(j+1) + 1 points a direction).
+    const int j = field.level(), m = field.order(), cells = 1 << j, n = 2 * cells + 1;
+    std::vector<double> x(n);
+    for (int a = 0; a < n; ++a) x[a] = double(a) / (n - 1);
+    std::vector<Rgb> values(size_t(n) * n);
+    field.evaluate_grid(x.data(), n, x.data(), n, values.data());
+    for (int c = 0; c < 3; ++c) {
+        const double hi = std::max(0.0, upper[c]);
+        std::vector<char> outside(size_t(cells) * cells, 0);  // per cell
+        bool any = false;
+        for (int a = 0; a < n; ++a)
+            for (int b = 0; b < n; ++b) {
+                const double v = values[size_t(a) * n + b][c];
+                if (v >= -slack && v <= hi + slack) continue;
+                any = true;
+                // The point belongs to the cells around it.
+                for (int ci = std::max(0, (a - 1) / 2); ci <= std::min(cells - 1, a / 2); ++ci)
+                    for (int cj = std::max(0, (b - 1) / 2); cj <= std::min(cells - 1, b / 2); ++cj)
+                        outside[size_t(ci) * cells + cj] = 1;
+            }
+        if (!any) continue;
+        // Clip the coefficients whose B-spline covers such a cell: N(2^j s - k) lives on cells
+        // k .. k + m - 1.
+        CoefficientGrid& g = field.channel(c);
+        for (int k = g.first_k; k < g.first_k + g.n_k; ++k)
+            for (int l = g.first_l; l < g.first_l + g.n_l; ++l) {
+                bool covers = false;
+                for (int ci = std::max(0, k); ci <= std::min(cells - 1, k + m - 1) && !covers; ++ci)
+                    for (int cj = std::max(0, l); cj <= std::min(cells - 1, l + m - 1); ++cj)
+                        if (outside[size_t(ci) * cells + cj]) {
+                            covers = true;
+                            break;
+                        }
+                if (covers) g(k, l) = std::clamp(g(k, l), 0.0, hi);
+            }
+    }
+}
+
+Rgb coefficient_bound(const SplineField& field) {
+    Rgb bound;
+    for (int c = 0; c < 3; ++c)
+        for (double a : field.channel(c).a) bound[c] = std::max(bound[c], a);
+    return bound;
 }
 
 bool stores_irradiance(const Scene& scene, int surface, const SolverOptions& options) {
@@ -463,11 +512,27 @@ void ProgressiveSolver::superpose(const std::vector<int>& receivers, std::vector
     if (row.empty()) row.assign(n, Rgb{});
     shot_power_[h] += shot_power;
     std::vector<SplineField> unshot_increments(n_rec);  // dB_i of the irradiance receivers
+    const Rgb shooter_bound = coefficient_bound(shooter.unshot);  // >= max B_h
     for (int k = 0; k < n_rec; ++k) {
         const int i = receivers[k];
         Received& r = results[k];
         const bool irradiance = solution_.quantity[i] == FieldQuantity::irradiance;
-        if (irradiance) unshot_increments[k] = reflected_field(i, r.field);
+        const Rgb rho_max = scene_.material_of(i).reflectance.maximum();
+        if (options_.limiter) {
+            const Rgb before = power(i, r.field);
+            const double slack =
+                options_.tolerance * radiosity_scale_ / (irradiance ? max_abs(rho_max) : 1.0);
+            limit_increment(r.field, irradiance ? shooter_bound : rho_max * shooter_bound, slack);
+            const Rgb change = power(i, r.field) - before;
+            shot.limited += channel_sum(
+                irradiance ? scene_.material_of(i).reflectance.mean() * change : change);
+        }
+        if (irradiance) {
+            unshot_increments[k] = reflected_field(i, r.field);
+            if (options_.limiter)
+                limit_increment(unshot_increments[k], rho_max * shooter_bound,
+                                options_.tolerance * radiosity_scale_);
+        }
         const SplineField& dB = irradiance ? unshot_increments[k] : r.field;
         const Rgb reflected = power(i, dB);
         shot.reflected += channel_sum(reflected);
@@ -543,6 +608,7 @@ ShotStats ProgressiveSolver::shoot() {
     st.unshot_power = shot.unshot_after;
     st.kernel_evals += shot.kernel_evals;
     st.rays += shot.rays;
+    st.limited_power += shot.limited;
     st.per_shot.push_back(shot);
     return shot;
 }
