@@ -151,6 +151,6 @@ inline const std::string obj_sample =
     "v 0 0 0\nv 2 0 0\nv 2 1 0\nv 0 1 0\nv 1 2 0.3\nv -1 1 0\nvt 0 0\nvt 1 1\nvn 0 0 1\n"
     "o thing\ng part\nusemtl white\ns 1\n"
     "f 1 2 3 4\nf 1/1 2/2 3/1\nf 1//1 2//1 3//1 5//1 6//1\nf -6/-2/-1 -5/-1/-1 -4/-2/-1\n"
-    "usemtl light\nf 1 2 5 4\nf 1 2 3 5 6\ng\nf 4 3 2 1\n";
+    "usemtl light\nf 1 2 5 4\nf 6 5 3 2 1\ng\nf 4 3 2 1\n";
 
 }  // namespace mbr::fuzz_input
