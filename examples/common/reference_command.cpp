@@ -6,6 +6,7 @@
 #include <iostream>
 #include <string>
 
+#include "examples/common/scene_cli.h"
 #include "radiosity/reference/path_tracer.h"
 #include "radiosity/reference/probe.h"
 #include "radiosity/scene/scene_io.h"
@@ -68,6 +69,7 @@ int reference_command(Args& args) {
     const std::string& scene_path = positional[0];
     const Scene scene =
         ends_with(scene_path, ".obj") ? load_obj(scene_path) : load_scene(scene_path);
+    print_scene_warnings(std::cerr, scene);
     const std::vector<ProbePoint> points = read_probe_points(points_path);
     const Octree octree = build_octree(scene);
     const std::vector<SurfaceLocation> locations =
