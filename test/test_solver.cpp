@@ -507,3 +507,20 @@ TEST_CASE("solver: with the limiter, a light a hair above the floor stays within
     const auto paper = extremes(false);
     CHECK((paper.first < 0 || paper.second > 0.5 * 1.005));
 }
+
+TEST_CASE("solver: a floor of 1e8 under a 1 x 1 lamp gives a finite solution", "[solver]") {
+    // The ambient correction shared the unshot power by total area - area_j, which rounds to
+    // zero beside a floor of 1e16 (every value was NaN, the lamp's own emission too).
+    const Scene scene = scene_from(
+        "material grey reflectance 0.5 0.5 0.5\nmaterial light emission 1 1 1\n"
+        "rectangle floor grey  -5e7 0 -5e7  0 0 1e8  1e8 0 0\n"
+        "rectangle light light -0.5 1 -0.5  1 0 0  0 0 1\n");
+    const Solution solution = solve(scene, build_octree(scene), solver_options(scene.settings));
+    for (size_t i = 0; i < scene.surfaces.size(); ++i) {
+        const Rgb b = solution.radiosity[i].evaluate(0.5, 0.5);
+        CAPTURE(scene.surfaces[i].name);
+        CHECK(std::isfinite(b.r + b.g + b.b));
+    }
+    CHECK(solution.radiosity[size_t(scene.find_surface("light"))].evaluate(0.5, 0.5).r ==
+          Approx(1));
+}

@@ -10,6 +10,7 @@
 #include <cstdlib>
 #include <limits>
 #include <set>
+#include <stdexcept>
 
 #include "math/bspline.h"
 #include "math/check.h"
@@ -622,12 +623,26 @@ std::vector<Rgb> ProgressiveSolver::ambient_correction() const {
     const int n = static_cast<int>(scene_.surfaces.size());
     std::vector<Rgb> U(n), rho(n);
     std::vector<double> area(n);
-    double total_area = 0;
     for (int i = 0; i < n; ++i) {
         U[i] = power(i, solution_.unshot[i]);
         rho[i] = scene_.material_of(i).reflectance.mean();
         area[i] = scene_.surfaces[i].surface.area();
-        total_area += area[i];
+    }
+    // The area of the surfaces other than j, summed without j (not total - area_j, which a
+    // floor of 1e16 beside a 1 x 1 lamp cancels to zero: 1e16 + 1 rounds to 1e16), so that
+    // a surface's share never divides by zero.
+    std::vector<double> others(n, 0.0);
+    {
+        double before = 0;
+        for (int j = 0; j < n; ++j) {
+            others[j] = before;
+            before += area[j];
+        }
+        double after = 0;
+        for (int j = n - 1; j >= 0; --j) {
+            others[j] += after;
+            after += area[j];
+        }
     }
     auto coupling = [&](int j, int i) -> Rgb {
         if (!coupling_[j].empty()) {
@@ -636,7 +651,7 @@ std::vector<Rgb> ProgressiveSolver::ambient_correction() const {
                 f[c] = shot_power_[j][c] > 0 ? coupling_[j][i][c] / shot_power_[j][c] : 0.0;
             return f;
         }
-        const double f = i == j ? 0.0 : area[i] / (total_area - area[j]);
+        const double f = i == j || others[j] <= 0 ? 0.0 : area[i] / others[j];
         return {f, f, f};
     };
     std::vector<Rgb> X = U, gain(n);
@@ -678,6 +693,16 @@ Solution ProgressiveSolver::finish() {
             st.ambient_power += channel_sum(correction[i]) * scene_.surfaces[i].surface.area();
         }
     }
+    // NaN anywhere in a solution is an error, never an output.
+    for (size_t i = 0; i < out.radiosity.size(); ++i)
+        for (int c = 0; c < 3 && !out.radiosity[i].empty(); ++c)
+            for (double a : out.radiosity[i].channel(c).a)
+                if (!std::isfinite(a))
+                    throw std::runtime_error(
+                        "the solution of surface '" + scene_.surfaces[i].name +
+                        "' is not finite (NaN or infinity): the scene's sizes or emissions are "
+                        "beyond what the solver resolves; try `set ambient false` or a smaller "
+                        "scene extent");
     st.seconds = now() - start_seconds_;
     st.peak_memory_bytes = peak_memory_bytes();
     double largest = 0;
