@@ -206,6 +206,7 @@ struct Octree::Query {
     Vec3 inv_dir;                // 1 / dir per component (unused where dir is zero)
     bool any = false;            // any-hit query: stop at the first hit
     RayFilter filter;            // surfaces whose polygons are skipped
+    std::array<Vec3, 2> ends;    // segment_ends(ray), when filter.ends_on_surfaces
     int best = -1;               // polygon of the best hit so far
     std::array<int, 32> recent;  // polygon tested recently, by polygon index mod 32
     RayStats stats;
@@ -302,6 +303,10 @@ bool Octree::traverse(const Node& node, const Box3& cube, Query& q) const {
             ++q.stats.n_polygons_tested;
             std::optional<double> t = polygons_[id].intersect(q.ray);
             if (!t) continue;
+            // The same polygon keeps the same answer for the same ends, so skipping repeated
+            // tests stays sound.
+            if (q.filter.ends_on_surfaces && !polygons_[id].hit_counts(q.ends[0], q.ends[1]))
+                continue;
             if (q.any) {
                 q.best = id;
                 return true;
@@ -342,9 +347,16 @@ bool Octree::traverse(const Node& node, const Box3& cube, Query& q) const {
 }
 
 std::optional<Hit> Octree::closest_hit(const Ray& ray, RayStats* stats) const {
+    return closest_hit(ray, RayFilter{}, stats);
+}
+
+std::optional<Hit> Octree::closest_hit(const Ray& ray, const RayFilter& filter,
+                                       RayStats* stats) const {
     if (!root_) return std::nullopt;
     Query q;
     q.ray = ray;
+    q.filter = filter;
+    if (filter.ends_on_surfaces) q.ends = segment_ends(ray);
     q.recent.fill(-1);
     for (int k = 0; k < 3; ++k) q.inv_dir[k] = ray.dir[k] != 0 ? 1 / ray.dir[k] : 0;
     double t0 = ray.t_min, t1 = ray.t_max;
@@ -367,6 +379,7 @@ bool Octree::any_hit(const Ray& ray, const RayFilter& filter, RayStats* stats) c
     q.ray = ray;
     q.any = true;
     q.filter = filter;
+    if (filter.ends_on_surfaces) q.ends = segment_ends(ray);
     q.recent.fill(-1);
     for (int k = 0; k < 3; ++k) q.inv_dir[k] = ray.dir[k] != 0 ? 1 / ray.dir[k] : 0;
     double t0 = ray.t_min, t1 = ray.t_max;

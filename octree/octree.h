@@ -78,10 +78,13 @@ struct RayStats {
 };
 
 /// Polygons a ray query skips: those of up to two surfaces (a shadow ray between a shooter and a
-/// receiver is never blocked by the two surfaces themselves).
+/// receiver is never blocked by the two surfaces themselves), and, for a ray between points of
+/// true surfaces, the hits Polygon::hit_counts discounts near its ends.
 struct RayFilter {
     int skip_surface_a = -1;
     int skip_surface_b = -1;
+    bool ends_on_surfaces = false;  // the ray's ends, ray.at(t_min) and ray.at(t_max) (the first
+                                    //   only when t_max is infinite), lie on true surfaces
     bool skips(int surface) const { return surface == skip_surface_a || surface == skip_surface_b; }
 };
 
@@ -113,10 +116,13 @@ public:
     /// the polygon with the smallest index. Visits nodes front to back and stops at the first
     /// node that starts beyond the best hit so far. Adds its work to *stats if given.
     std::optional<Hit> closest_hit(const Ray& ray, RayStats* stats = nullptr) const;
+    /// The same, skipping the polygons and hits `filter` names.
+    std::optional<Hit> closest_hit(const Ray& ray, const RayFilter& filter,
+                                   RayStats* stats = nullptr) const;
     /// Whether any polygon is hit with t in [ray.t_min, ray.t_max] (shadow rays). Stops at the
     /// first hit found. Adds its work to *stats if given.
     bool any_hit(const Ray& ray, RayStats* stats = nullptr) const;
-    /// The same, skipping the polygons of the surfaces `filter` names.
+    /// The same, skipping the polygons and hits `filter` names.
     bool any_hit(const Ray& ray, const RayFilter& filter, RayStats* stats = nullptr) const;
     /// The polygons listed by the leaves whose grown cubes `node_may_meet` accepts (it is asked
     /// for every node on the way down, so a region query prunes whole subtrees), each once, in

@@ -27,6 +27,11 @@ std::ostream& operator<<(std::ostream& os, const Ray& ray) {
               << ray.t_max << "])";
 }
 
+std::array<Vec3, 2> segment_ends(const Ray& ray) {
+    const Vec3 a = ray.at(ray.t_min);
+    return {a, std::isfinite(ray.t_max) ? ray.at(ray.t_max) : a};
+}
+
 std::ostream& operator<<(std::ostream& os, const Polygon& polygon) {
     os << "polygon(surface " << polygon.surface() << ':';
     for (Vec3 v : polygon.vertices()) os << ' ' << v;
@@ -114,6 +119,34 @@ std::optional<double> Polygon::intersect(const Ray& ray) const {
     double t = -plane_.signed_distance(ray.origin) / denom;
     if (!std::isfinite(t) || t < ray.t_min || t > ray.t_max) return std::nullopt;
     if (!contains(ray.at(t))) return std::nullopt;
+    return t;
+}
+
+void Polygon::set_thickness(double thickness) {
+    MBR_CHECK_MSG(std::isfinite(thickness) && thickness >= 0, "thickness " << thickness);
+    thickness_ = thickness;
+}
+
+bool Polygon::within_thickness(Vec3 p) const {
+    if (!(thickness_ > 0)) return false;
+    // Written as !(|d| <= thickness) so that a NaN counts as far.
+    if (!(std::fabs(plane_.signed_distance(p)) <= thickness_)) return false;
+    // DESIGN: laterally, the box grown by the diameter: the points of a neighbour's true surface
+    // that stand within the thickness of this plane reach that far beyond the shared edge (for
+    // a sphere, up to the circle the plane cuts, through the polygon's corners, which is within
+    // a diameter of them). Grown by the thickness alone, the sphere of 5 bands kept false
+    // shadows: 0.134 % too dark at worst with paper shadows, 0.119 % with exact ones, against
+    // 0.020 % (its error without any shadows) with the diameter.
+    const Vec3 grow{diameter_, diameter_, diameter_};
+    const Vec3 lo = bounds_.lo - grow, hi = bounds_.hi + grow;
+    return p.x >= lo.x && p.x <= hi.x && p.y >= lo.y && p.y <= hi.y && p.z >= lo.z && p.z <= hi.z;
+}
+
+std::optional<double> Polygon::intersect_segment(const Ray& ray) const {
+    const std::optional<double> t = intersect(ray);
+    if (!t || thickness_ == 0) return t;
+    const std::array<Vec3, 2> ends = segment_ends(ray);
+    if (!hit_counts(ends[0], ends[1])) return std::nullopt;
     return t;
 }
 

@@ -13,8 +13,21 @@
 //   radiosity, but an occluder blocks from either side; culling is the caller's business).
 // - A ray parallel to the plane (including a ray lying in it) never hits: the polygon has no
 //   thickness, and the set of such rays has measure zero.
+//
+// Beyond the paper: a polygon of a curved surface's tessellation is a chord of it. Its
+// thickness() (set by whoever made it from the surface; zero for an exact, planar facet) bounds
+// how far the true surface stands off the polygon's plane over the polygon and just beyond. A
+// segment between two points of true surfaces that starts (or ends) within that thickness of the
+// plane, near the polygon, starts on the surface this polygon, or its neighbour across a shared
+// edge, only approximates: a hit there is the tessellation's, not the surface's, and does not
+// block (hit_counts, intersect_segment). Two sphere bands meeting along a circle: the plane of a
+// facet of one cuts the sphere in a circle through the facet's corners, and the other band's
+// points inside that circle stand on the far side of the plane, so their rays to the facet's side
+// crossed it. A closed curved occluder is crossed twice, so a discounted hit near an end leaves
+// it blocking; an open one leaks only where the tessellation already does (within the thickness).
 #pragma once
 
+#include <array>
 #include <cmath>
 #include <optional>
 #include <ostream>
@@ -36,6 +49,9 @@ struct Ray {
 };
 /// Prints origin, direction and the t range.
 std::ostream& operator<<(std::ostream& os, const Ray& ray);
+/// The ends of a ray taken as a segment: ray.at(t_min), and ray.at(t_max) when t_max is finite
+/// (else the first again).
+std::array<Vec3, 2> segment_ends(const Ray& ray);
 
 /// An oriented plane {p : dot(normal, p) = offset} with unit normal; the normal side is positive.
 struct Plane {
@@ -82,6 +98,11 @@ public:
     /// Outward tolerance of the inside test: a point counts as inside when no bounding plane
     /// puts it further out than this (1e-10 x diameter).
     double edge_slack() const { return edge_slack_; }
+    /// How far the true surface this polygon approximates may stand off plane() over the polygon
+    /// and just beyond (0, the default: the polygon is exact). See the file comment.
+    double thickness() const { return thickness_; }
+    /// Sets thickness(); checks (MBR_CHECK) that it is finite and not negative.
+    void set_thickness(double thickness);
 
     /// True when p, taken to lie in the polygon's plane, is on the inner side of every bounding
     /// plane (closed, with edge_slack()): step 2 of the paper's ray-polygon test.
@@ -91,6 +112,18 @@ public:
     /// to the plane or t is outside [t_min, t_max]); the hit point is inside iff contains() holds.
     /// Returns t. Front and back faces both count.
     std::optional<double> intersect(const Ray& ray) const;
+
+    /// True when p may lie on the true surface near this polygon rather than on the polygon:
+    /// within thickness() of plane() and inside bounds() grown by diameter() on every side.
+    /// Never for a polygon of zero thickness (or a p that is not finite).
+    bool within_thickness(Vec3 p) const;
+    /// The rule of visibility between points of true surfaces: a hit on this polygon by the
+    /// segment from `a` to `b` blocks unless within_thickness() holds at an end.
+    bool hit_counts(Vec3 a, Vec3 b) const { return !within_thickness(a) && !within_thickness(b); }
+    /// intersect() for a segment between points of true surfaces, its ends ray.at(ray.t_min) and
+    /// ray.at(ray.t_max) (only the first when t_max is infinite): the hit unless hit_counts()
+    /// discounts it. Equal to intersect() for a polygon of zero thickness.
+    std::optional<double> intersect_segment(const Ray& ray) const;
 
     /// The surface parameters (u, v) at a point p of the polygon (p is first projected onto the
     /// plane): barycentric for triangles, inverse bilinear for quadrilaterals (vertex i at
@@ -115,6 +148,7 @@ private:
     double area_ = 0;
     double edge_slack_ = 0;
     double planarity_error_ = 0;
+    double thickness_ = 0;
     // An orthonormal frame of the plane (origin at vertex 0) and the vertices in it, for uv_at.
     Vec3 axis_u_, axis_v_;
     std::vector<Vec2> local_;

@@ -708,3 +708,116 @@ TEST_CASE("octree: concurrent queries agree with sequential ones", "[octree]") {
     for (std::thread& t : threads) t.join();
     CHECK(parallel == sequential);
 }
+
+// ---- Segments between true surfaces: a polygon's thickness (polygon.h) -------------------------
+
+TEST_CASE("octree: a hit within a polygon's thickness of a segment's end does not block",
+          "[octree][thickness]") {
+    // The unit square in z = 0 as a facet whose true surface stands up to 0.05 off its plane
+    // (the rule's box: the square's box grown by its diameter, sqrt 2, on every side).
+    Polygon facet = make_polygon({{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}});
+    const Polygon exact = facet;
+    facet.set_thickness(0.05);
+    CHECK(facet.thickness() == 0.05);
+    CHECK(exact.thickness() == 0);
+    auto segment = [](Vec3 a, Vec3 b) { return Ray{a, b - a, 1e-9, 1 - 1e-9}; };
+    // From 0.02 above the plane, just beyond the edge y = 1 (a neighbour's true surface), into
+    // the square and below: the plane is crossed at y = 0.997, inside.
+    const Ray near_end = segment({0.5, 1.05, 0.02}, {0.5, 0.2, -0.3});
+    REQUIRE(facet.intersect(near_end));
+    CHECK(facet.within_thickness(near_end.origin));
+    CHECK_FALSE(facet.intersect_segment(near_end));
+    CHECK(exact.intersect_segment(near_end) == exact.intersect(near_end));  // zero: plain test
+    // The same hit from the other end (the rule is symmetric in the ends).
+    const Ray reversed = segment({0.5, 0.2, -0.3}, {0.5, 1.05, 0.02});
+    REQUIRE(facet.intersect(reversed));
+    CHECK_FALSE(facet.intersect_segment(reversed));
+    // An end beyond the thickness (0.08 above the plane) blocks as before.
+    const Ray high = segment({0.5, 1.05, 0.08}, {0.5, 0.2, -0.3});
+    REQUIRE(facet.intersect(high));
+    CHECK_FALSE(facet.within_thickness(high.origin));
+    CHECK(facet.intersect_segment(high) == facet.intersect(high));
+    // Ends within the thickness of the plane but outside the grown box (y = 3 and y = -2) block.
+    const Ray far = segment({0.5, 3, 0.02}, {0.5, -2, -0.02});
+    REQUIRE(facet.intersect(far));
+    CHECK_FALSE(facet.within_thickness(far.origin));
+    CHECK(facet.intersect_segment(far) == facet.intersect(far));
+    // A ray with an infinite t_max has one end, at t_min (a ray leaving a surface).
+    const Ray open{{0.5, 1.05, 0.02}, {0, -0.85, -0.32}, 0.05, HUGE_VAL};
+    REQUIRE(facet.intersect(open));
+    const std::array<Vec3, 2> ends = segment_ends(open);
+    CHECK(ends[0].y == open.at(0.05).y);
+    CHECK(ends[1].y == ends[0].y);
+    CHECK_FALSE(facet.intersect_segment(open));
+    // Not finite: never within.
+    CHECK_FALSE(facet.within_thickness({HUGE_VAL, 0.5, 0}));
+    CHECK_FALSE(facet.within_thickness({std::nan(""), 0.5, 0}));
+    CHECK_THROWS_AS(facet.set_thickness(-1), CheckFailure);
+
+    // The octree applies the rule only when asked (RayFilter::ends_on_surfaces): behind the facet
+    // lies an exact polygon the segment also crosses, which then is the first hit.
+    const Polygon behind = make_polygon({{0, 0, -0.2}, {1, 0, -0.2}, {1, 1, -0.2}, {0, 1, -0.2}}, 1);
+    const Octree octree({facet, behind});
+    const Ray down = segment({0.5, 1.05, 0.02}, {0.5, 0.2, -0.3});
+    const RayFilter between{-1, -1, true};
+    CHECK(octree.any_hit(down));
+    CHECK(octree.any_hit(down, between));  // the exact polygon still blocks
+    REQUIRE(octree.closest_hit(down));
+    CHECK(octree.closest_hit(down)->polygon == 0);
+    REQUIRE(octree.closest_hit(down, between));
+    CHECK(octree.closest_hit(down, between)->polygon == 1);
+    const Octree alone({facet});
+    CHECK(alone.any_hit(down));
+    CHECK_FALSE(alone.any_hit(down, between));
+    CHECK_FALSE(alone.closest_hit(down, between));
+}
+
+TEST_CASE("octree: queries between true surfaces equal brute force over the rule",
+          "[octree][thickness]") {
+    // Random polygons with random thicknesses (half of them zero), rays of every kind; with
+    // RayFilter::ends_on_surfaces the octree must answer as a loop over Polygon::intersect
+    // with Polygon::hit_counts at the ray's ends.
+    const unsigned seed = 2024;
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> u01(0, 1);
+    std::vector<Polygon> scene = random_scene(rng, 800);
+    for (Polygon& p : scene)
+        if (u01(rng) < 0.5) p.set_thickness(0.3 * u01(rng) * p.diameter());
+    const Octree octree(scene);
+    const RayFilter between{-1, -1, true};
+    long n_any = 0, n_discounted = 0;
+    for (int r = 0; r < 3000; ++r) {
+        const Ray ray = random_ray(rng, scene, r);
+        // Half the segments start on a polygon's plane near it (a point of a curved surface).
+        Ray s = ray;
+        if (r % 2) {
+            const Polygon& p = scene[size_t(r) % scene.size()];
+            const Vec3 a = p.vertices()[0] + 0.3 * p.thickness() * p.normal();
+            s = Ray{a, ray.origin - a, 1e-9, 1 - 1e-9};
+        }
+        const std::array<Vec3, 2> ends = segment_ends(s);
+        std::optional<Hit> best;
+        bool any = false, any_plain = false;
+        for (int i = 0; i < static_cast<int>(scene.size()); ++i) {
+            const std::optional<double> t = scene[i].intersect(s);
+            if (!t) continue;
+            any_plain = true;
+            if (!scene[i].hit_counts(ends[0], ends[1])) continue;
+            CHECK(scene[i].intersect_segment(s) == t);
+            any = true;
+            if (!best || *t < best->t) best = Hit{i, scene[i].surface(), {}, *t};
+        }
+        CAPTURE(seed, r, s);
+        CHECK(octree.any_hit(s, between) == any);
+        const std::optional<Hit> got = octree.closest_hit(s, between);
+        REQUIRE(got.has_value() == best.has_value());
+        if (got) {
+            CHECK(got->polygon == best->polygon);
+            CHECK(got->t == best->t);
+        }
+        n_any += any;
+        n_discounted += any_plain && !any;
+    }
+    CHECK(n_any > 300);
+    CHECK(n_discounted > 20);  // the rule did discount some segments' only hits
+}
