@@ -9,11 +9,15 @@
 #include <optional>
 #include <random>
 #include <set>
+#include <sstream>
+#include <string>
 #include <vector>
 
 #include "math/bspline.h"
 #include "math/gauss_legendre.h"
 #include "radiosity/reference/configurations.h"
+#include "radiosity/scene/scene_io.h"
+#include "radiosity/scene/scene_octree.h"
 #include "radiosity/transfer/sample_values.h"
 #include "radiosity/transfer/transfer.h"
 #include "radiosity/visibility/occlusion.h"
@@ -158,11 +162,15 @@ TEST_CASE("shadow: make_occlusion_context finds every polygon that meets the pai
           "[shadow][occlusion]") {
     // Random shooter and receiver quads (and, every fourth time, a cylinder patch as the
     // receiver: its hull points are its bounding box's corners) with random occluders around
-    // them. Brute force: a polygon meets the convex hull of hull_points(shooter) and
-    // hull_points(receiver) iff no separating axis exists (hull_polygon_gap). A polygon
-    // meeting it by more than 1e-7 (the library drops polygons within 1e-9 x the coordinates of
-    // the hull's boundary) must be a candidate: no false negatives ever. False positives (listed,
-    // but apart) only cost rays; they are counted. The two surfaces' own polygons never are.
+    // them. Brute force: a polygon meets the convex hull of the two true surfaces iff no
+    // separating axis exists (hull_polygon_gap); a curved surface's hull is taken from 6 x 6
+    // of its points (the brute force is cubic in the points), which lie inside it, so a polygon
+    // that meets the points' hull meets the true one. (Not the bounding box's corners:
+    // make_occlusion_context may drop a polygon that meets their hull but has both true surfaces on
+    // one side of its plane.) A polygon meeting it by more than 1e-7 (the library drops polygons
+    // within 1e-9 x the coordinates of the hull's boundary) must be a candidate: no false negatives
+    // ever. False positives (listed, but apart) only cost rays; they are counted. The two surfaces'
+    // own polygons never are.
     const unsigned seed = 123;
     std::mt19937 rng(seed);
     std::uniform_real_distribution<double> u(0, 1);
@@ -193,7 +201,12 @@ TEST_CASE("shadow: make_occlusion_context finds every polygon that meets the pai
             make_occlusion_context(octree, shooter, 0, receiver, 1, config);
         CHECK(std::is_sorted(ctx.candidates.begin(), ctx.candidates.end()));
         std::vector<Vec3> pts = hull_points(shooter);
-        for (const Vec3& q : hull_points(receiver)) pts.push_back(q);
+        if (receiver.is_planar()) {
+            for (const Vec3& q : hull_points(receiver)) pts.push_back(q);
+        } else {
+            for (int i = 0; i <= 5; ++i)
+                for (int j = 0; j <= 5; ++j) pts.push_back(receiver.point(i / 5.0, j / 5.0));
+        }
         for (int id : ctx.candidates) CHECK(octree.polygons()[id].surface() >= 2);
         for (int i = 0; i < 25; ++i) {
             const int id = first_occluder + i;
@@ -260,4 +273,100 @@ TEST_CASE("shadow: segment_blocked equals brute force with few and with many can
     CHECK(n_many > 0);
     CHECK(n_blocked > n_segments / 10);
     CHECK(n_blocked < n_segments);
+}
+
+// ---- Curved neighbours: segments leave true surfaces, not facets -------------------------------
+
+namespace {
+
+/// A point of the radius-1 sphere about the origin (pole +z) at polar angle theta, azimuth phi
+/// (degrees).
+Vec3 on_sphere(double theta, double phi) {
+    const double t = theta * Pi / 180, f = phi * Pi / 180;
+    return {std::sin(t) * std::cos(f), std::sin(t) * std::sin(f), std::cos(t)};
+}
+
+Scene parse(const std::string& text) {
+    std::istringstream in(text);
+    return parse_scene(in, "test.scene");
+}
+
+}  // namespace
+
+TEST_CASE("shadow: the facets of a curved neighbour do not block segments from its true surface",
+          "[shadow][occlusion][thickness]") {
+    // Inside a sphere nothing occludes anything. Cap (0-30 deg), band A (30-60), band B (60-90):
+    // the plane of a facet of A in its last row cuts the sphere in a circle through the facet's
+    // corners, and the points of B just below the shared circle inside it stand on the far side
+    // of that plane, so a chord from them to the cap crossed the facet: false occlusion (measured
+    // before the rule: most of these segments were blocked).
+    const Scene scene = parse(
+        "material m reflectance 0.5 0.5 0.5\n"
+        "sphere cap m 0 0 0  0 0 1  1 0 0  1  0 30  0 360 inward\n"
+        "sphere A m 0 0 0  0 0 1  1 0 0  1  30 60  0 360 inward\n"
+        "sphere B m 0 0 0  0 0 1  1 0 0  1  60 90  0 360 inward\n");
+    const Octree octree = build_octree(scene);
+    for (const Polygon& p : octree.polygons()) REQUIRE(p.thickness() > 0);
+    const OcclusionContext ctx = make_occlusion_context(octree, scene.surfaces[0].surface, 0,
+                                                        scene.surfaces[2].surface, 2, 0);
+    const unsigned seed = 31;
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> u01(0, 1);
+    int n_facet_hits = 0, n_blocked = 0;
+    const int n = 2000;
+    for (int s = 0; s < n; ++s) {
+        // p on B within 1.5 deg of the shared circle, q anywhere on the cap's outer half.
+        const Vec3 p = on_sphere(60 + 1.5 * u01(rng), 360 * u01(rng));
+        const Vec3 q = on_sphere(15 + 15 * u01(rng), 360 * u01(rng));
+        const Ray ray{p, q - p, 1e-9, 1 - 1e-9};
+        bool facet_hit = false;
+        for (const Polygon& poly : octree.polygons())
+            if (poly.surface() == 1 && poly.intersect(ray)) facet_hit = true;
+        long n_rays = 0;
+        CAPTURE(seed, s, p, q);
+        const bool blocked = segment_blocked(ctx, p, q, &n_rays);
+        CHECK_FALSE(blocked);
+        n_facet_hits += facet_hit;
+        n_blocked += blocked;
+    }
+    CHECK(n_facet_hits > n / 10);  // the facets are crossed: the rule is what keeps them clear
+    CHECK(n_blocked == 0);
+}
+
+TEST_CASE("shadow: a curved occluder still blocks, resting on the receiver or not",
+          "[shadow][occlusion][thickness]") {
+    // A closed curved occluder is crossed twice; discounting the facets near a segment's end
+    // leaves the far crossing. A ball resting on a floor and a cylinder standing on it, a square
+    // lamp above: segments from floor points under them (up to the contact) to the lamp are
+    // blocked, those that pass beside them are not.
+    const Scene scene = parse(
+        "material m reflectance 0.5 0.5 0.5\n"
+        "rectangle floor m  -2 0 -2   0 0 4   4 0 0\n"
+        "rectangle lamp m  -0.2 3 -0.2   0.4 0 0   0 0 0.4\n"
+        "sphere ball m  0 0.5 0   0 1 0   1 0 0   0.5   0 180   0 360\n"
+        "cylinder post m  1.2 0 0   0 1 0   1 0 0   0.3 1   0 360\n");
+    const Octree octree = build_octree(scene);
+    const OcclusionContext ctx = make_occlusion_context(octree, scene.surfaces[1].surface, 1,
+                                                        scene.surfaces[0].surface, 0, 0);
+    REQUIRE_FALSE(ctx.clear());
+    const Vec3 light{0, 3, 0};
+    long n_rays = 0;
+    // Under the ball: the contact point's neighbourhood, within the bottom facets' thickness.
+    for (double x : {0.0, 0.004, 0.02, 0.1, 0.3}) {
+        CAPTURE(x);
+        CHECK(segment_blocked(ctx, {x, 0, 0}, light, &n_rays));
+        CHECK(segment_blocked(ctx, {x, 0, 0}, light + Vec3{0.15, 0, 0.1}, &n_rays));
+    }
+    // Inside the post (a tube, radius 0.3 about x = 1.2: these segments to the lamp leave
+    // through its far wall below its top), and outside it beyond the thickness of its facets
+    // (0.05 and 0.2 from the wall; the segments cross the whole tube below its top).
+    const Vec3 base{1.2, 0, 0};
+    for (double dx : {0.05, 0.1, 0.35, 0.5}) {
+        CAPTURE(dx);
+        CHECK(segment_blocked(ctx, base + Vec3{dx, 0, 0}, light, &n_rays));
+    }
+    // Beside both, and on the floor's far corner: clear.
+    CHECK_FALSE(segment_blocked(ctx, {0.85, 0, 0}, light, &n_rays));
+    CHECK_FALSE(segment_blocked(ctx, {-1.5, 0, -1.5}, light, &n_rays));
+    CHECK_FALSE(segment_blocked(ctx, {0.6, 0, -1.5}, light, &n_rays));
 }

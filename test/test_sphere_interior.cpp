@@ -6,6 +6,14 @@
 // radiosity is uniform: B = rho (E A_c + B A_r) / (4 pi R^2), B = rho E A_c / (4 pi R^2 - rho A_r).
 // Each piece of the rest also receives from itself (self_transfer, on by default): without that, a
 // single surface is 46.7 % too dark (measured before the default changed).
+//
+// The rest in pieces: rays between them are tested against the facets of the other pieces, which
+// are chords of the sphere; a piece's true surface next to a shared edge stands beyond its
+// neighbour's facets' planes, and those facets used to catch its rays (issue 19: 5 bands were
+// 4.5 % too dark on average with paper shadows, 24.7 % at worst; exact shadows did not finish).
+// The facets' thickness (octree/polygon.h) discounts such hits. Last, a real curved occluder must
+// still cast its shadow.
+#include <algorithm>
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <sstream>
@@ -73,4 +81,98 @@ TEST_CASE("sphere interior: one surface receives its own light by default", "[so
     options.self_transfer = false;
     const Solution without = solve(scene, octree, options);
     CHECK(largest_error(scene, without) > 0.3);
+}
+
+TEST_CASE("sphere interior: 5 bands, exact and paper shadows, within 0.1 %", "[solver][sphere]") {
+    // DESIGN: coarser than the defaults (tolerance 0.1, convergence 0.05) so that each solve takes
+    // seconds; the defaults give the same 0.020 % (docs/method.md). The bands cost time through
+    // their transfers to themselves and their neighbours, not through visibility. Without shadows
+    // nothing can be lost to visibility: that run is the measurement's, not the test's.
+    for (const char* shadows : {"exact", "paper"}) {
+        CAPTURE(shadows);
+        const Scene scene = sphere_interior(
+            5, 1,
+            std::string("set shadows ") + shadows + "\nset tolerance 0.1\nset convergence 0.05\n");
+        const Octree octree = build_octree(scene);
+        const Solution solution = solve(scene, octree, solver_options(scene.settings));
+        CHECK(solution.stats.converged);
+        CHECK(largest_error(scene, solution) <= 1e-3);
+    }
+}
+
+TEST_CASE("sphere interior: 3 bands of 2 sectors, exact and paper shadows, within 0.1 %",
+          "[solver][sphere]") {
+    // Edges along meridians too, and pieces meeting at the south pole, where paper shadows were
+    // 9.6 % too dark before the facets' thickness (0.9 % at the side; measured with this scene
+    // at tolerance 0.2, convergence 0.02). The 20 pieces of the issue (5 bands of 4 sectors) are
+    // measured at the defaults in docs/method.md; here 6, so that the suite stays short.
+    for (const char* shadows : {"exact", "paper"}) {
+        CAPTURE(shadows);
+        const Scene scene = sphere_interior(
+            3, 2,
+            std::string("set shadows ") + shadows + "\nset tolerance 0.2\nset convergence 0.02\n");
+        const Octree octree = build_octree(scene);
+        const Solution solution = solve(scene, octree, solver_options(scene.settings));
+        CHECK(solution.stats.converged);
+        CHECK(largest_error(scene, solution) <= 1e-3);
+    }
+}
+
+namespace {
+
+/// The point-to-disk form factor for a point at height h below a parallel disk of radius a, at
+/// distance r from its axis (the disk facing the point).
+double disk_form_factor(double h, double r, double a) {
+    const double s = h * h + r * r + a * a;
+    return 0.5 * (1 - (h * h + r * r - a * a) / std::sqrt(s * s - 4 * r * r * a * a));
+}
+
+}  // namespace
+
+TEST_CASE("sphere occluder: a ball and a tube between a disk lamp and a floor cast their shadows",
+          "[solver][sphere][shadow]") {
+    // A disk lamp (radius 0.2, emission 10) 2 above a floor of reflectance 0.5; black occluders:
+    // a ball (radius 0.3) floating under the lamp, a ball resting on the floor and a tube (an open
+    // cylinder) standing on it. Nothing else reflects, so the floor's radiosity is one bounce,
+    // B = rho E F, with F the disk's form factor where the lamp is in full view and 0 in the
+    // umbrae. The disk shoots with a ray per quadrature node (exact shadows) or with the fractions
+    // of eq. (28) (paper); before the facets' thickness, the exact run did not finish its first
+    // shot in 300 s (a disk lamp over a ball on a floor).
+    const double E = 10, rho = 0.5, h = 2, a = 0.2;
+    for (const char* shadows : {"exact", "paper"}) {
+        CAPTURE(shadows);
+        std::istringstream text(
+            std::string("material floor reflectance 0.5 0.5 0.5\n"
+                        "material black reflectance 0 0 0\n"
+                        "material lamp emission 10 10 10\n"
+                        "rectangle floor floor  -2 0 -2   0 0 4   4 0 0\n"
+                        "disk lamp lamp  0 2 0   0 -1 0   1 0 0   0 0.2   0 360\n"
+                        "sphere ball black  0 1 0   0 1 0   1 0 0   0.3   0 180   0 360\n"
+                        "sphere rest black  1 0.25 -1   0 1 0   1 0 0   0.25   0 180   0 360\n"
+                        "cylinder tube black  -1 0 1   0 1 0   1 0 0   0.2 0.6   0 360\n"
+                        "set shadows ") +
+            shadows + "\n");
+        const Scene scene = parse_scene(text, "occluders.scene");
+        const Octree octree = build_octree(scene);
+        const Solution solution = solve(scene, octree, solver_options(scene.settings));
+        // The floor: corner (-2, 0, -2), u along z, v along x.
+        auto B = [&](double x, double z) {
+            return solution.radiosity[0].evaluate((z + 2) / 4, (x + 2) / 4)[0];
+        };
+        auto lit = [&](double x, double z) {
+            return rho * E * disk_form_factor(h, std::hypot(x, z), a);
+        };
+        // In full view of the lamp (checked by hand against the three occluders' silhouettes).
+        for (const Vec2 q : {Vec2{1.5, 0}, Vec2{0, -1.5}, Vec2{-1.5, -1.5}, Vec2{1.7, 1.7}}) {
+            CAPTURE(q.x, q.y, B(q.x, q.y), lit(q.x, q.y));
+            CHECK(B(q.x, q.y) == Approx(lit(q.x, q.y)).epsilon(0.01));
+        }
+        // Umbrae: under the floating ball (it hides 17.5 degrees, the lamp 5.7), next to the
+        // resting ball's contact point, behind the tube's wall (seen from the lamp's centre).
+        for (const Vec2 q : {Vec2{0, 0}, Vec2{0.05, 0.05}, Vec2{1.05, -1.05}, Vec2{1.1, -1.1},
+                             Vec2{-1.25, 1.25}}) {
+            CAPTURE(q.x, q.y, B(q.x, q.y), lit(q.x, q.y));
+            CHECK(std::fabs(B(q.x, q.y)) <= 0.05 * lit(q.x, q.y));
+        }
+    }
 }

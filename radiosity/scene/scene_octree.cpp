@@ -3,6 +3,7 @@
 #include "radiosity/scene/scene_octree.h"
 
 #include <algorithm>
+#include <cmath>
 #include <optional>
 #include <utility>
 
@@ -101,6 +102,45 @@ Split split(const Piece& piece, int apex, int surface) {
     return result;
 }
 
+// DESIGN: the thickness of a facet of a curved surface (Polygon::thickness) is measured, not
+// derived: the surface is evaluated on a grid over the facet's (u, v) polygon scaled by
+// thickness_reach about its centroid (reaching a quarter further out than each vertex, where a
+// neighbour continues the surface), and the largest distance from the facet's plane, times
+// thickness_safety (for the maximum between the grid's points and neighbours that bend a little
+// more), is the thickness. thickness_grid + 1 points along each side of the fan's triangles: the
+// distance is smooth (quadratic over a chord), so the grid misses little of its maximum.
+constexpr double thickness_reach = 1.25;
+constexpr double thickness_safety = 2;
+constexpr int thickness_grid = 8;
+
+/// How far `surface` stands off the plane of `polygon` (one of its facets) over the polygon's
+/// (u, v) polygon and just beyond, with the safety factor; zero for the surfaces whose facets
+/// are exact (planar quads and disks), and where the distance is only rounding.
+double facet_thickness(const Surface& surface, const Polygon& polygon) {
+    if (surface.is_planar()) return 0;
+    const std::vector<Vec2>& uv = polygon.uv();
+    const int n = static_cast<int>(uv.size());
+    Vec2 centre;
+    for (const Vec2& q : uv) centre = centre + (1.0 / n) * q;
+    double largest = 0;
+    // The fan of triangles (centre, vertex k, vertex k+1) covers the convex (u, v) polygon.
+    for (int k = 0; k < n; ++k) {
+        const Vec2 a = thickness_reach * (uv[k] - centre),
+                   b = thickness_reach * (uv[(k + 1) % n] - centre);
+        for (int i = 0; i <= thickness_grid; ++i)
+            for (int j = 0; i + j <= thickness_grid; ++j) {
+                const Vec2 q =
+                    centre + (double(i) / thickness_grid) * a + (double(j) / thickness_grid) * b;
+                const double d = polygon.plane().signed_distance(surface.point(q.x, q.y));
+                largest = std::max(largest, std::fabs(d));
+            }
+    }
+    // DESIGN: a distance below 1e-9 of the facet's diameter is the rounding of an exact facet
+    // (a flat bilinear patch): zero, so such facets keep the plain ray-polygon test.
+    if (largest <= 1e-9 * polygon.diameter()) return 0;
+    return thickness_safety * largest;
+}
+
 }  // namespace
 
 std::vector<Polygon> scene_polygons(const Scene& scene, int tessellation,
@@ -153,6 +193,8 @@ std::vector<Polygon> scene_polygons(const Scene& scene, int tessellation,
             for (Polygon& p : best.polygons) polygons.push_back(std::move(p));
         }
         if (polygons.size() == first) ++s.n_empty_surfaces;
+        for (size_t k = first; k < polygons.size(); ++k)
+            polygons[k].set_thickness(facet_thickness(scene.surfaces[id].surface, polygons[k]));
     }
     s.n_polygons = static_cast<int>(polygons.size());
     if (stats) *stats = s;

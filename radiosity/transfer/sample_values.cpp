@@ -379,6 +379,63 @@ IncrementIntegrator::PointSpan IncrementIntegrator::horizon_points(const QuadCel
     return {it->second.data(), static_cast<int>(it->second.size())};
 }
 
+void IncrementIntegrator::collect_shaft_occluders(const SurfacePoint& p, const QuadCell& cell,
+                                                  const PointSpan& pts) {
+    // A polygon whose box misses the box of p and the cell, whose plane has them all on one
+    // side, or whose bounding ball misses the capsule around the segment from p to the ball of
+    // the nodes, cannot come between p and the cell.
+    Box3 shaft, nodes;
+    shaft.extend(p.position);
+    for (int i = 0; i < pts.count; ++i) nodes.extend(pts.first[i].x);
+    shaft.extend(nodes);
+    const Rect& r = cell.rect;
+    for (const Vec2 c : {Vec2{r.x0, r.y0}, Vec2{r.x1, r.y0}, Vec2{r.x0, r.y1}, Vec2{r.x1, r.y1}})
+        shaft.extend(shooter_.surface->point(c.x, c.y));
+    const Vec3 c_nodes = nodes.centre();
+    double r_nodes = 0;
+    for (int i = 0; i < pts.count; ++i)
+        r_nodes = std::max(r_nodes, length(pts.first[i].x - c_nodes));
+    // DESIGN: 1e-9 of the coordinates' size: rounding never drops a polygon a ray could meet.
+    const double capsule_slack =
+        1e-9 * (length(p.position) + length(c_nodes) + length(shaft.extent()));
+    const Vec3 axis = c_nodes - p.position;
+    const double axis_2 = dot(axis, axis);
+    auto outside_capsule = [&](const Box3& box) {
+        const Vec3 m = box.centre();
+        const double rho = 0.5 * length(box.extent());
+        const double s = axis_2 > 0 ? std::clamp(dot(m - p.position, axis) / axis_2, 0.0, 1.0) : 0;
+        return length(m - (p.position + s * axis)) > r_nodes + rho + capsule_slack;
+    };
+    const std::vector<Polygon>& polys = occlusion_->octree->polygons();
+    const std::vector<int>& list = view_.use_rays ? view_.occluders : occlusion_->candidates;
+    local_.clear();
+    for (int id : list) {
+        const Polygon& poly = polys[id];
+        if (!overlaps(poly.bounds(), shaft)) continue;
+        if (outside_capsule(poly.bounds())) continue;
+        const Plane& pl = poly.plane();
+        // p and the ball of the nodes on one side of the plane: no segment crosses it (inside a
+        // sphere, every facet's plane but those next to p).
+        const double d_p = pl.signed_distance(p.position), d_c = pl.signed_distance(c_nodes);
+        if ((d_p > capsule_slack && d_c > r_nodes + capsule_slack) ||
+            (d_p < -capsule_slack && d_c < -r_nodes - capsule_slack))
+            continue;
+        // A facet of a curved surface near p never blocks its segments (Polygon::hit_counts).
+        if (poly.within_thickness(p.position)) continue;
+        double lo = HUGE_VAL, hi = -HUGE_VAL;
+        for (int corner = 0; corner < 8; ++corner) {
+            const Vec3 c{(corner & 1) ? shaft.hi.x : shaft.lo.x,
+                         (corner & 2) ? shaft.hi.y : shaft.lo.y,
+                         (corner & 4) ? shaft.hi.z : shaft.lo.z};
+            const double d = pl.signed_distance(c);
+            lo = std::min(lo, d);
+            hi = std::max(hi, d);
+        }
+        if (lo > 0 || hi < 0) continue;
+        local_.push_back(id);
+    }
+}
+
 Rgb IncrementIntegrator::cell_value(const SurfacePoint& p, const QuadCell& cell, int n) {
     const bool rays = !planar_ || view_.use_rays;  // visibility by one ray per node
     if (planar_ && !view_.trivial() && !view_.use_rays) {
@@ -407,59 +464,32 @@ Rgb IncrementIntegrator::cell_value(const SurfacePoint& p, const QuadCell& cell,
     }
     if (!occlusion_ || !rays) return sum_over(p, points(cell, n));
     // A curved shooter, or too many occluders to project: one visibility ray per node (eq. (21)
-    // with VIS), tested against the occluders that can come between p and this cell (a
-    // polygon whose box misses the box of p and the cell, or whose plane has them all on one
-    // side, cannot); none: no rays at all.
+    // with VIS), tested against the occluders that can come between p and this cell; none: no
+    // rays at all.
     const PointSpan pts = points(cell, n);
-    Box3 shaft;
-    shaft.extend(p.position);
-    for (int i = 0; i < pts.count; ++i) shaft.extend(pts.first[i].x);
-    const Rect& r = cell.rect;
-    for (const Vec2 c : {Vec2{r.x0, r.y0}, Vec2{r.x1, r.y0}, Vec2{r.x0, r.y1}, Vec2{r.x1, r.y1}})
-        shaft.extend(shooter_.surface->point(c.x, c.y));
-    const std::vector<Polygon>& polys = occlusion_->octree->polygons();
-    const std::vector<int>& list = view_.use_rays ? view_.occluders : occlusion_->candidates;
-    local_.clear();
-    for (int id : list) {
-        const Polygon& poly = polys[id];
-        if (!overlaps(poly.bounds(), shaft)) continue;
-        const Plane& pl = poly.plane();
-        double lo = HUGE_VAL, hi = -HUGE_VAL;
-        for (int corner = 0; corner < 8; ++corner) {
-            const Vec3 c{(corner & 1) ? shaft.hi.x : shaft.lo.x,
-                         (corner & 2) ? shaft.hi.y : shaft.lo.y,
-                         (corner & 4) ? shaft.hi.z : shaft.lo.z};
-            const double d = pl.signed_distance(c);
-            lo = std::min(lo, d);
-            hi = std::max(hi, d);
-        }
-        if (lo > 0 || hi < 0) continue;
-        local_.push_back(id);
-    }
+    collect_shaft_occluders(p, cell, pts);
     if (local_.empty()) return sum_over(p, pts);
-    Rgb sum;
+    Rgb sum, unoccluded;
     int n_visible = 0, n_blocked = 0;
     for (int i = 0; i < pts.count; ++i) {
         const ShooterPoint& q = pts.first[i];
         const double F = form_factor_kernel(p.position, p.normal, q.x, q.n);
         if (F == 0) continue;
-        ++rays_;
-        // DESIGN: the open segment, as segment_blocked: t in [1e-9, 1 - 1e-9].
-        const Ray ray{p.position, q.x - p.position, 1e-9, 1 - 1e-9};
-        bool blocked = false;
-        for (int id : local_)
-            if (polys[id].intersect(ray)) {
-                blocked = true;
-                break;
-            }
-        if (blocked) {
+        unoccluded += F * q.e;
+        // The segment between the two true surfaces, tested as the paper's shadow rays are: one
+        // by one against the shaft's list, through the octree beyond max_shaft_occluders.
+        if (segment_blocked(*occlusion_, local_, p.position, q.x, &rays_, max_shaft_occluders)) {
             ++n_blocked;
             continue;
         }
         ++n_visible;
         sum += F * q.e;
     }
-    if (n_visible > 0 && n_blocked > 0) mixed_.push_back(cell_key(cell));
+    // A cell whose nodes disagree is split (integrate's `near`) while what its visibility can
+    // get wrong, at most its value without occluders, exceeds the tolerance; below, the n
+    // against n + 1 estimate decides, like any other cell's.
+    if (n_visible > 0 && n_blocked > 0 && max_abs(unoccluded) > mixed_tolerance_)
+        mixed_.push_back(cell_key(cell));
     return sum;
 }
 
@@ -522,6 +552,8 @@ IncrementIntegrator::Result IncrementIntegrator::integrate(const SurfacePoint& p
     // n + 1 test, so without this cap its cells would split down to max_depth.
     const bool ray_visibility = occlusion_ && (!planar_ || view_.use_rays);
     if (ray_visibility) opt.max_depth = std::min(opt.max_depth, options_.max_visibility_depth);
+    // DESIGN: see mixed_tolerance_ (sample_values.h).
+    mixed_tolerance_ = ray_visibility ? opt.tolerance : 0;
     opt.min_depth = min_depth >= 0 ? std::min(min_depth, options_.max_depth) : options_.min_depth;
     opt.min_share = options_.min_share;
     opt.global = options_.global;
