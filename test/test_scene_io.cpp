@@ -247,7 +247,7 @@ TEST_CASE("scene_io: extra numbers", "[scene_io][errors]") {
                 "quad needs 12 numbers (p00 x y z, p10 x y z, p11 x y z, p01 x y z), found 13");
     check_error("material m reflectance 0.5 0.5 0.5 0.5\n", 1, "unexpected number '0.5'");
     check_error(white + "disk d white 0 0 0  0 0 1  1 0 0  0 1  0 360 inward\n", 2,
-                "found 14: unexpected 'inward'");
+                "unknown word 'inward' after the disk's numbers (only 'order M' may follow)");
     check_error(white + square + "camera eye 0 0 5 1 look_at 0 0 0\n", 3, "unexpected number '1'");
 }
 

@@ -56,6 +56,16 @@ std::string Scene::where(int surface) const {
     return sources[size_t(s.source)] + ":" + std::to_string(s.line);
 }
 
+int surface_order(const Scene& scene, int surface, int global_order) {
+    MBR_CHECK_MSG(surface >= 0 && size_t(surface) < scene.surfaces.size(), "surface " << surface);
+    const int own = scene.surfaces[size_t(surface)].order;
+    return own > 0 ? own : global_order;
+}
+
+int surface_order(const Scene& scene, int surface) {
+    return surface_order(scene, surface, scene.settings.order);
+}
+
 void Scene::warn(const SceneWarning& w) {
     for (SceneWarning& x : warnings)
         if (x.kind == w.kind) {

@@ -39,6 +39,10 @@ struct SceneSurface {
     int material = -1;
     int source = -1;  // index into Scene::sources: the file of its statement
     int line = 0;     // the statement's line there (1-based)
+    /// The B-spline order m of this surface's fields, 2..8 (its statement's `order M`), or 0:
+    /// the scene's order (`set order`, `--order`; SolverSettings::order). "On different
+    /// surfaces in an environment, different B-spline bases can be used" (paper section 3).
+    int order = 0;
 };
 
 /// Something the readers accepted but the user should hear of (a repeated surface they
@@ -105,5 +109,11 @@ struct Scene {
     /// instance and adds w.count to its count.
     void warn(const SceneWarning& w);
 };
+
+/// The order m of surface i's fields: its own `order M`, else `global_order` (the solver's,
+/// SolverOptions::receiver.m, which `set order` and `--order` give).
+int surface_order(const Scene& scene, int surface, int global_order);
+/// The same with the scene's `set order` (SolverSettings::order) as the global order.
+int surface_order(const Scene& scene, int surface);
 
 }  // namespace mbr

@@ -4,6 +4,7 @@
 #include "radiosity/scene/scene_reader.h"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <fstream>
 #include <istream>
@@ -89,16 +90,61 @@ std::string describe_fields(const std::vector<Field>& fields) {
     return s;
 }
 
-/// Reads the numbers of `fields` from tokens[first..]; an optional trailing word `flag` (e.g.
-/// "inward") sets *flag_set. Wrong counts and non-numbers get messages naming the fields.
-std::vector<double> read_fields(const Line& line, size_t first, const std::string& statement,
-                                const std::vector<Field>& fields, const char* flag = nullptr,
-                                bool* flag_set = nullptr) {
-    size_t end = line.size();
-    if (flag && end > first && line[end - 1] == flag) {
-        *flag_set = true;
-        --end;
+/// The optional words after a surface's numbers: `inward` (box, cylinder, sphere) and
+/// `order M`, in either order. The numbers end where they begin.
+struct SurfaceWords {
+    size_t end = 0;       // one past the last number
+    bool inward = false;  // the surface faces in
+    int order = 0;        // its B-spline order m, 2..8; 0: the scene's (SceneSurface::order)
+};
+
+/// "order must be an integer 2..8": one whole number in that range.
+int parse_order(const Line& line, const std::string& token) {
+    long long m = 0;
+    const char* b = token.data();
+    const char* e = b + token.size();
+    const auto result = std::from_chars(b, e, m);
+    if (b == e || result.ec != std::errc() || result.ptr != e || m < 2 || m > 8)
+        line.fail("order must be an integer 2..8, found " + in_quotes(token));
+    return int(m);
+}
+
+/// Takes the optional words off the end of a statement whose numbers (or file name) start at
+/// tokens[first]; `has_inward` when it accepts `inward`. Another word at the end is refused,
+/// the message naming what it follows (`after`: "the quad's numbers").
+SurfaceWords trailing_words(const Line& line, size_t first, bool has_inward,
+                            const std::string& after) {
+    SurfaceWords w;
+    w.end = line.size();
+    bool seen_order = false;
+    while (w.end > first) {
+        const std::string& last = line[w.end - 1];
+        if (has_inward && !w.inward && last == "inward") {
+            w.inward = true;
+            --w.end;
+        } else if (has_inward && last == "inward") {
+            line.fail("'inward' is given twice");
+        } else if (last == "order") {
+            line.fail("'order' needs a value: an integer 2..8");
+        } else if (w.end >= first + 2 && line[w.end - 2] == "order") {
+            if (seen_order) line.fail("'order' is given twice");
+            w.order = parse_order(line, last);
+            seen_order = true;
+            w.end -= 2;
+        } else if (!is_number_token(last)) {
+            line.fail("unknown word " + in_quotes(last) + " after " + after + " (only " +
+                      (has_inward ? "'inward' and 'order M' may" : "'order M' may") + " follow)");
+        } else {
+            break;
+        }
     }
+    return w;
+}
+
+/// Reads the numbers of `fields` from tokens[first..end). Wrong counts and non-numbers get
+/// messages naming the fields.
+std::vector<double> read_fields(const Line& line, size_t first, size_t end,
+                                const std::string& statement, const std::vector<Field>& fields) {
     int expected = 0;
     for (const Field& f : fields) expected += f.count;
     int found = int(end - first);
@@ -276,7 +322,8 @@ private:
 
     // --- surfaces: KIND NAME MATERIAL numbers...
 
-    void add_surface(const Line& line, const std::string& name, int material, Surface s) {
+    void add_surface(const Line& line, const std::string& name, int material, Surface s,
+                     int order) {
         double area = s.area();
         if (!(area > 0) || !std::isfinite(area))
             line.fail("degenerate surface " + in_quotes(name) + ": its area is " +
@@ -286,7 +333,8 @@ private:
         if (!is_new)
             line.fail("duplicate surface name " + in_quotes(name) + " (first used at " +
                       seen->second + ")");
-        scene_.surfaces.push_back({name, std::move(s), material, source(line.file), line.number});
+        scene_.surfaces.push_back(
+            {name, std::move(s), material, source(line.file), line.number, order});
     }
 
     Surface checked_quad(const Line& line, const Quad& q) {
@@ -310,36 +358,52 @@ private:
             line.fail("unknown material " + in_quotes(mat_name) +
                       " (materials must be defined before the surfaces that use them)");
         const int material = found->second.index;
-        bool inward = false;
+        // DESIGN: `order M` may follow any surface's numbers, and `inward` where the kind has
+        // it, in either order: per-surface orders are the paper's "different B-spline bases"
+        // on different surfaces (section 3); without it the scene's `set order` holds.
+        const bool has_inward = kind == "box" || kind == "cylinder" || kind == "sphere";
+        const SurfaceWords words =
+            trailing_words(line, 3, has_inward, "the " + kind + "'s numbers");
+        const auto numbers = [&](const std::vector<Field>& fields) {
+            return read_fields(line, 3, words.end, kind, fields);
+        };
         if (kind == "quad" || kind == "bilinear") {
-            auto x = read_fields(line, 3, kind, {{"p00", 3}, {"p10", 3}, {"p11", 3}, {"p01", 3}});
+            auto x = numbers({{"p00", 3}, {"p10", 3}, {"p11", 3}, {"p01", 3}});
             Quad q = {vec_at(x, 0), vec_at(x, 3), vec_at(x, 6), vec_at(x, 9)};
             if (kind == "quad") {
-                add_surface(line, name, material, checked_quad(line, q));
+                add_surface(line, name, material, checked_quad(line, q), words.order);
                 return;
             }
             for (int i = 0; i < 4; ++i) check_point(line, q[i], "corner");
-            add_surface(line, name, material, checked_bilinear(line, q));
+            add_surface(line, name, material, checked_bilinear(line, q), words.order);
         } else if (kind == "rectangle") {
-            auto x = read_fields(line, 3, kind, {{"corner", 3}, {"edge_u", 3}, {"edge_v", 3}});
+            auto x = numbers({{"corner", 3}, {"edge_u", 3}, {"edge_v", 3}});
             Vec3 c = vec_at(x, 0), eu = vec_at(x, 3), ev = vec_at(x, 6);
             check_point(line, c, "corner");
             check_direction(line, eu, "edge_u");
             check_direction(line, ev, "edge_v");
-            add_surface(line, name, material, checked_quad(line, {c, c + eu, c + eu + ev, c + ev}));
+            add_surface(line, name, material, checked_quad(line, {c, c + eu, c + eu + ev, c + ev}),
+                        words.order);
         } else if (kind == "box") {
-            auto x = read_fields(line, 3, kind, {{"lo", 3}, {"hi", 3}}, "inward", &inward);
-            box(line, name, material, vec_at(x, 0), vec_at(x, 3), inward);
-        } else if (kind == "cylinder") {
-            auto x = read_fields(line, 3, kind,
-                                 {{"base", 3},
-                                  {"axis", 3},
-                                  {"e1", 3},
-                                  {"radius", 1},
-                                  {"height", 1},
-                                  {"phi0", 1},
-                                  {"phi1", 1}},
-                                 "inward", &inward);
+            auto x = numbers({{"lo", 3}, {"hi", 3}});
+            box(line, name, material, vec_at(x, 0), vec_at(x, 3), words);
+        } else {
+            add_surface(line, name, material, curved(line, kind, words, numbers), words.order);
+        }
+    }
+
+    /// The cylinder, sphere or disk of a statement, checked.
+    template <class Numbers>
+    Surface curved(const Line& line, const std::string& kind, const SurfaceWords& words,
+                   const Numbers& numbers) {
+        if (kind == "cylinder") {
+            auto x = numbers({{"base", 3},
+                              {"axis", 3},
+                              {"e1", 3},
+                              {"radius", 1},
+                              {"height", 1},
+                              {"phi0", 1},
+                              {"phi1", 1}});
             Vec3 base = vec_at(x, 0), axis = vec_at(x, 3), e1 = vec_at(x, 6);
             check_point(line, base, "base");
             check_direction(line, axis, "axis");
@@ -348,20 +412,18 @@ private:
             double r = check_length(line, x[9], "radius", false);
             double h = check_length(line, x[10], "height", false);
             check_angle_range(line, x[11], x[12], "phi", 360);
-            add_surface(
-                line, name, material,
-                Surface::cylinder(base, axis, e1, r, h, radians(x[11]), radians(x[12]), inward));
-        } else if (kind == "sphere") {
-            auto x = read_fields(line, 3, kind,
-                                 {{"centre", 3},
-                                  {"pole", 3},
-                                  {"e1", 3},
-                                  {"radius", 1},
-                                  {"theta0", 1},
-                                  {"theta1", 1},
-                                  {"phi0", 1},
-                                  {"phi1", 1}},
-                                 "inward", &inward);
+            return Surface::cylinder(base, axis, e1, r, h, radians(x[11]), radians(x[12]),
+                                     words.inward);
+        }
+        if (kind == "sphere") {
+            auto x = numbers({{"centre", 3},
+                              {"pole", 3},
+                              {"e1", 3},
+                              {"radius", 1},
+                              {"theta0", 1},
+                              {"theta1", 1},
+                              {"phi0", 1},
+                              {"phi1", 1}});
             Vec3 centre = vec_at(x, 0), pole = vec_at(x, 3), e1 = vec_at(x, 6);
             check_point(line, centre, "centre");
             check_direction(line, pole, "pole");
@@ -373,30 +435,27 @@ private:
                     line.fail("sphere theta " + fmt(x[i]) + " is outside [0, 180] degrees");
             check_angle_range(line, x[10], x[11], "theta", 180);
             check_angle_range(line, x[12], x[13], "phi", 360);
-            add_surface(line, name, material,
-                        Surface::sphere(centre, pole, e1, r, radians(x[10]), radians(x[11]),
-                                        radians(x[12]), radians(x[13]), inward));
-        } else {  // disk
-            auto x = read_fields(line, 3, kind,
-                                 {{"centre", 3},
-                                  {"normal", 3},
-                                  {"e1", 3},
-                                  {"r0", 1},
-                                  {"r1", 1},
-                                  {"phi0", 1},
-                                  {"phi1", 1}});
-            Vec3 centre = vec_at(x, 0), normal = vec_at(x, 3), e1 = vec_at(x, 6);
-            check_point(line, centre, "centre");
-            check_direction(line, normal, "normal");
-            check_direction(line, e1, "e1");
-            check_not_parallel(line, normal, e1, "normal");
-            double r0 = check_length(line, x[9], "r0", true);
-            double r1 = check_length(line, x[10], "r1", false);
-            if (!(r1 > r0)) line.fail("disk r1 " + fmt(r1) + " must exceed r0 " + fmt(r0));
-            check_angle_range(line, x[11], x[12], "phi", 360);
-            add_surface(line, name, material,
-                        Surface::disk(centre, normal, e1, r0, r1, radians(x[11]), radians(x[12])));
+            return Surface::sphere(centre, pole, e1, r, radians(x[10]), radians(x[11]),
+                                   radians(x[12]), radians(x[13]), words.inward);
         }
+        // disk
+        auto x = numbers({{"centre", 3},
+                          {"normal", 3},
+                          {"e1", 3},
+                          {"r0", 1},
+                          {"r1", 1},
+                          {"phi0", 1},
+                          {"phi1", 1}});
+        Vec3 centre = vec_at(x, 0), normal = vec_at(x, 3), e1 = vec_at(x, 6);
+        check_point(line, centre, "centre");
+        check_direction(line, normal, "normal");
+        check_direction(line, e1, "e1");
+        check_not_parallel(line, normal, e1, "normal");
+        double r0 = check_length(line, x[9], "r0", true);
+        double r1 = check_length(line, x[10], "r1", false);
+        if (!(r1 > r0)) line.fail("disk r1 " + fmt(r1) + " must exceed r0 " + fmt(r0));
+        check_angle_range(line, x[11], x[12], "phi", 360);
+        return Surface::disk(centre, normal, e1, r0, r1, radians(x[11]), radians(x[12]));
     }
 
     /// A bilinear patch must not fold: the normals at the corners agree with the centre's.
@@ -425,9 +484,11 @@ private:
         return s;
     }
 
-    /// Six quads of an axis-aligned box, named NAME.xmin ... NAME.zmax, facing out (or in).
+    /// Six quads of an axis-aligned box, named NAME.xmin ... NAME.zmax, facing out (or in with
+    /// `inward`), each of the statement's order.
     void box(const Line& line, const std::string& name, int material, Vec3 lo, Vec3 hi,
-             bool inward) {
+             const SurfaceWords& words) {
+        const bool inward = words.inward;
         check_point(line, lo, "box lo");
         check_point(line, hi, "box hi");
         for (int a = 0; a < 3; ++a)
@@ -447,7 +508,7 @@ private:
                 Vec3 e_u = plus ? eb : ec, e_v = plus ? ec : eb;
                 Quad q = {base, base + e_u, base + e_u + e_v, base + e_v};
                 std::string face = name + "." + "xyz"[a] + (side == 1 ? "max" : "min");
-                add_surface(line, face, material, checked_quad(line, q));
+                add_surface(line, face, material, checked_quad(line, q), words.order);
             }
     }
 
@@ -530,10 +591,15 @@ private:
         if (key == "min_depth" || key == "max_depth") depth_line_ = line;
     }
 
-    // --- obj FILE, include FILE
+    // --- obj FILE [order M], include FILE
 
     void obj(const Line& line) {
-        if (line.size() != 2) line.fail("'obj' needs one file name");
+        if (line.size() < 2) line.fail("'obj' needs one file name");
+        // `order M` gives every surface of the import that order (SceneSurface::order).
+        const SurfaceWords words = trailing_words(line, 2, false, "the OBJ file's name");
+        if (words.end != 2)
+            line.fail("unknown word " + in_quotes(line[2]) +
+                      " after the OBJ file's name (only 'order M' may follow)");
         std::string path = resolve(line.file, line[1]);
         state_.charge(line);
         std::ifstream in;
@@ -557,6 +623,7 @@ private:
         }
         for (SceneSurface& s : part.surfaces) {
             s.material = index[size_t(s.material)];
+            s.order = words.order;
             if (s.source >= 0) s.source = source(part.sources[size_t(s.source)]);
             auto [seen, is_new] = surface_where_.try_emplace(s.name, path);
             if (!is_new)
