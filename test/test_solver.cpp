@@ -379,10 +379,10 @@ TEST_CASE("solver: damaged, truncated and foreign solution files are refused", "
               std::string::npos);
     }
     SECTION("another version: refused") {
-        std::string v3 = text;
-        v3.replace(0, v3.find('\n'), "mbr-solution 3");
-        CHECK(load_error(v3, scene).find("x.solution:1: solution format version 3 is not "
-                                         "supported (this mbr reads versions 1 to 2)") == 0);
+        std::string v4 = text;
+        v4.replace(0, v4.find('\n'), "mbr-solution 4");
+        CHECK(load_error(v4, scene).find("x.solution:1: solution format version 4 is not "
+                                         "supported (this mbr reads versions 1 to 3)") == 0);
         // Version 2 reads version 1's lines; only version 2 may name an irradiance field.
         std::string v2 = text;
         v2.replace(0, v2.find('\n'), "mbr-solution 2");

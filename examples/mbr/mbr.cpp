@@ -300,15 +300,19 @@ Solution relight(SceneRun& run, const GroupPlan& plan, bool report, std::ostream
         Scene group_scene = light_group_scene(run.scene, plan.groups, int(g));
         if (!plan.load[g].empty()) {
             solutions.push_back(load_group_solution(run, plan, g, group_scene));
-            // The fields of one sum must share the order (the levels may differ).
-            const int m =
-                solutions.back().radiosity.empty() ? 0 : solutions.back().radiosity[0].order();
-            const int m0 = solutions[0].radiosity.empty() ? 0 : solutions[0].radiosity[0].order();
-            if (m != m0)
-                throw InputError(plan.load[g], 3,
-                                 "the fields are of order " + std::to_string(m) + ", those of " +
-                                     plan.load[0] + " of order " + std::to_string(m0) +
-                                     ": solve every light group with the same order");
+            // The fields of one surface must share the order in every sum (the levels may
+            // differ; the surfaces' orders may differ too, SceneSurface::order).
+            for (size_t i = 0; i < run.scene.surfaces.size(); ++i) {
+                const int m = solutions.back().radiosity[i].order();
+                const int m0 = solutions[0].radiosity[i].order();
+                if (m != m0)
+                    throw InputError(plan.load[g], 0,
+                                     "surface '" + run.scene.surfaces[i].name +
+                                         "' has fields of order " + std::to_string(m) +
+                                         " here and of order " + std::to_string(m0) + " in " +
+                                         plan.load[0] +
+                                         ": solve every light group with the same orders");
+            }
             // And each surface's field must hold the same quantity (B, or H: `set texture_field`).
             for (size_t i = 0; i < run.scene.surfaces.size(); ++i) {
                 const auto holds = [i](const Solution& s) {

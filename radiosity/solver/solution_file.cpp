@@ -2,6 +2,7 @@
 // so that rendering can be separate from solving.
 #include "radiosity/solver/solution_file.h"
 
+#include <algorithm>
 #include <cerrno>
 #include <cinttypes>
 #include <cmath>
@@ -23,9 +24,13 @@ namespace {
 
 constexpr const char* magic = "mbr-solution";
 // Version 2 adds `irradiance level J` in place of `radiosity level J` for a field that holds H
-// (FieldQuantity::irradiance). A solution without such fields is written as version 1, which
-// every earlier mbr reads; both versions are read.
-constexpr int format_version = 2;
+// (FieldQuantity::irradiance). Version 3 adds `order m` to each surface line, for a solution
+// whose surfaces have different orders (SceneSurface::order); the header's order is then the
+// largest. DESIGN: a file is written in the oldest version that holds it (1 without H fields
+// and with one order, 2 with H fields and one order, else 3), so that what earlier mbr wrote
+// and read stays byte for byte the same; every version is read.
+constexpr int format_version = 3;
+constexpr int irradiance_version = 2;
 constexpr int oldest_version = 1;
 
 bool any_irradiance(const Solution& solution) {
@@ -173,15 +178,29 @@ void save_solution(std::ostream& out, const Scene& scene, const Solution& soluti
               solution.unshot.size() == scene.surfaces.size());
     char fp[32];
     std::snprintf(fp, sizeof fp, "%016" PRIx64, scene_fingerprint(scene));
+    // Each surface's fields share its order; the surfaces' orders may differ (version 3).
     int m = 0;
-    for (const SplineField& f : solution.radiosity) m = std::max(m, f.order());
+    bool one_order = true;
+    for (size_t i = 0; i < scene.surfaces.size(); ++i) {
+        const int mi = solution.radiosity[i].order();
+        MBR_CHECK_MSG(solution.unshot[i].order() == mi, "surface " << i << ": B of order " << mi
+                                                                   << ", unshot of order "
+                                                                   << solution.unshot[i].order());
+        one_order = one_order && (i == 0 || mi == m);
+        m = std::max(m, mi);
+    }
     const bool irradiance = any_irradiance(solution);
     MBR_CHECK(solution.quantity.empty() || solution.quantity.size() == scene.surfaces.size());
-    out << magic << " " << (irradiance ? format_version : oldest_version) << "\n"
+    const int version = !one_order   ? format_version
+                        : irradiance ? irradiance_version
+                                     : oldest_version;
+    out << magic << " " << version << "\n"
         << "fingerprint " << fp << "\n"
         << "surfaces " << scene.surfaces.size() << " order " << m << "\n";
     for (size_t i = 0; i < scene.surfaces.size(); ++i) {
-        out << "surface " << i << " " << scene.surfaces[i].name << "\n";
+        out << "surface " << i << " " << scene.surfaces[i].name;
+        if (!one_order) out << " order " << solution.radiosity[i].order();
+        out << "\n";
         const bool holds_h = irradiance && solution.quantity[i] == FieldQuantity::irradiance;
         write_field(out, holds_h ? "irradiance" : "radiosity", solution.radiosity[i]);
         write_field(out, "unshot", solution.unshot[i]);
@@ -229,17 +248,26 @@ Solution load_solution(std::istream& in, const std::string& name, const Scene& s
     s.leaves.resize(n);
     for (long i = 0; i < n; ++i) {
         const std::vector<std::string> sh = r.words("a surface");
-        r.expect(sh, "surface", 3);
+        // Version 3: `surface i NAME order m`, the surface's own order (at most the header's).
+        r.expect(sh, "surface", version >= 3 ? 5 : 3);
         if (r.integer(sh[1], 0, n - 1, "a surface index") != i) r.fail("surfaces are out of order");
         if (sh[2] != scene.surfaces[i].name)
             r.fail("surface " + std::to_string(i) + " is '" + sh[2] + "', the scene's is '" +
                    scene.surfaces[i].name + "'");
+        int mi = m;
+        if (version >= 3) {
+            if (sh[3] != "order") r.fail("expected 'surface i NAME order m'");
+            mi = int(r.integer(sh[4], 2, 8, "an order"));
+            if (mi > m)
+                r.fail("surface " + std::to_string(i) + " has order " + std::to_string(mi) +
+                       ", above the largest order " + std::to_string(m) + " of the header");
+        }
         // Version 2: the field line names what the field holds.
         bool holds_h = false;
         s.radiosity[i] =
-            read_field(r, "radiosity", m, version >= 2 ? "irradiance" : nullptr, &holds_h);
+            read_field(r, "radiosity", mi, version >= 2 ? "irradiance" : nullptr, &holds_h);
         if (holds_h) s.quantity[i] = FieldQuantity::irradiance;
-        s.unshot[i] = read_field(r, "unshot", m);
+        s.unshot[i] = read_field(r, "unshot", mi);
         const std::vector<std::string> lh = r.words("leaves");
         r.expect(lh, "leaves", 2);
         const long n_leaves = r.integer(lh[1], 0, 1L << 30, "a leaf count");

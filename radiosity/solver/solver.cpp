@@ -314,10 +314,21 @@ RadiosityView radiosity_view(const Scene& scene, const Solution& solution) {
 
 ProgressiveSolver::ProgressiveSolver(const Scene& scene, const Octree& octree,
                                      const SolverOptions& options)
-    : scene_(scene), octree_(octree), options_(options), dual_(options.receiver.m) {
+    : scene_(scene), octree_(octree), options_(options) {
     start_seconds_ = now();
     const int n = static_cast<int>(scene.surfaces.size());
-    const int m = options.receiver.m;
+    // DESIGN: each surface's fields take its own order ("on different surfaces in an
+    // environment, different B-spline bases can be used", section 3): B, dB_unshot, the
+    // emission's projection, the ambient constant and every transfer to it. A transfer's
+    // receiver is of the receiver's order and its shooter field of the shooter's; the samples
+    // (21) evaluate the shooter field whatever its order, so the two never need to agree.
+    order_.resize(n);
+    duals_.resize(9);
+    for (int i = 0; i < n; ++i) {
+        const int m = order_[i] = surface_order(scene, i, options.receiver.m);
+        MBR_CHECK_MSG(m >= 2 && m <= 8, "order m = " << m << " of surface " << i);
+        if (!duals_[m]) duals_[m] = std::make_unique<DualTable>(m);
+    }
     solution_.radiosity.resize(n);
     solution_.quantity.assign(n, FieldQuantity::radiosity);
     solution_.unshot.resize(n);
@@ -335,6 +346,7 @@ ProgressiveSolver::ProgressiveSolver(const Scene& scene, const Octree& octree,
     Rgb emitted_rgb;
     for (int i = 0; i < n; ++i) {
         const Material& mat = scene.material_of(i);
+        const int m = order_[i];
         if (stores_irradiance(scene, i, options)) solution_.quantity[i] = FieldQuantity::irradiance;
         if (mat.emits()) {
             solution_.unshot[i] = project_emission(mat.emission, m, options.emission_level);
@@ -364,7 +376,7 @@ const std::vector<double>& ProgressiveSolver::power_weights(int surface, int lev
     if (!w.empty()) return w;
     // w_kl = int int N_m(2^j s - k) N_m(2^j t - l) A(s, t) ds dt, by (m + 2)-point Gauss per
     // cell: exact for planar quads (A is linear in s and t), accurate for curved surfaces.
-    const int m = options_.receiver.m;
+    const int m = order_[surface];
     const int first = first_touching_index(m), n = touching_count(m, level), cells = 1 << level;
     const GaussLegendre rule = gauss_legendre(m + 2);
     const Surface& S = scene_.surfaces[surface].surface;
@@ -392,7 +404,11 @@ const std::vector<double>& ProgressiveSolver::power_weights(int surface, int lev
 }
 
 Rgb ProgressiveSolver::power(int surface, const SplineField& field) const {
-    // int B A = sum_kl c_kl w_kl (the B-splines' weights against the area factor).
+    // int B A = sum_kl c_kl w_kl (the B-splines' weights against the area factor), the
+    // weights of the surface's order, which every field of it has.
+    MBR_CHECK_MSG(field.order() == order_[surface],
+                  "a field of order " << field.order() << " on surface " << surface << " of order "
+                                      << order_[surface]);
     const std::vector<double>& w = power_weights(surface, field.level());
     Rgb p;
     for (int c = 0; c < 3; ++c) {
@@ -411,7 +427,7 @@ SplineField ProgressiveSolver::reflected_field(int surface, const SplineField& d
     const Texture& rho = scene_.material_of(surface).reflectance;
     const int level = std::min(dH.level(), SolverOptions::emission_level);
     return l2_projection([&](double s, double t) { return rho.value(s, t) * dH.evaluate(s, t); },
-                         options_.receiver.m, level);
+                         order_[surface], level);
 }
 
 double ProgressiveSolver::unshot_power(int surface) const {
@@ -461,6 +477,7 @@ std::vector<ProgressiveSolver::Received> ProgressiveSolver::transfer_to(
         // H long before the spline follows it (a checker plate under a square light: 1.8 % at
         // the square centres with the means, 0.29 % with the fit; docs/method.md).
         ReceiverOptions options = ro;
+        options.m = order_[i];  // the receiver's basis
         if (irradiance) {
             const double largest = max_abs(rho.maximum());
             options.absolute_tolerance /= largest;
@@ -479,8 +496,8 @@ std::vector<ProgressiveSolver::Received> ProgressiveSolver::transfer_to(
         const OcclusionContext occlusion = make_occlusion_context(
             octree_, shooter_surface, h, scene_.surfaces[i].surface, i, std::uint64_t(shot_number));
         ReceiverState state;
-        results[k].field =
-            transfer(shooter, receiver, options, &results[k].stats, &state, &occlusion, &dual_);
+        results[k].field = transfer(shooter, receiver, options, &results[k].stats, &state,
+                                    &occlusion, duals_[size_t(options.m)].get());
         for (int index = 0; index < state.forest.n_nodes(); ++index) {
             const Forest::Node& node = state.forest.node(index);
             if (!node.is_leaf() && node.cell.in_domain())
@@ -560,7 +577,7 @@ void ProgressiveSolver::superpose(const std::vector<int>& receivers, std::vector
     const Surface& shooter_surface = scene_.surfaces[h].surface;
     if (!(options_.self_transfer && shooter_surface.is_concave() &&
           std::find(receivers.begin(), receivers.end(), h) != receivers.end())) {
-        solution_.unshot[h] = SplineField::constant(options_.receiver.m, 0, {0, 0, 0});
+        solution_.unshot[h] = SplineField::constant(order_[h], 0, {0, 0, 0});
     } else {
         // The shooter received from itself during the shot: keep only what it received.
         for (int k = 0; k < n_rec; ++k)
@@ -689,7 +706,7 @@ Solution ProgressiveSolver::finish() {
                 const Rgb rv = scene_.material_of(i).reflectance.mean();
                 for (int c = 0; c < 3; ++c) added[c] = rv[c] > 0 ? added[c] / rv[c] : 0.0;
             }
-            out.radiosity[i].add(SplineField::constant(options_.receiver.m, 0, added));
+            out.radiosity[i].add(SplineField::constant(order_[i], 0, added));
             st.ambient_power += channel_sum(correction[i]) * scene_.surfaces[i].surface.area();
         }
     }

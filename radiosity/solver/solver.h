@@ -18,6 +18,7 @@
 
 #include <functional>
 #include <iosfwd>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -33,7 +34,9 @@ namespace mbr {
 
 /// Options of the progressive loop and of its transfers.
 struct SolverOptions {
-    ReceiverOptions receiver;   // every transfer's options (order, depths, shadows, ...)
+    ReceiverOptions receiver;   // every transfer's options (order, depths, shadows, ...); its
+                                //   order m is that of the surfaces without their own
+                                //   (SceneSurface::order), each transfer takes its receiver's
     int max_shots = 100;        // stop after this many shots
     double convergence = 1e-3;  // stop when the largest unshot power < this x emitted
     bool self_transfer = true;  // concave curved surfaces receive from themselves
@@ -165,7 +168,10 @@ private:
     const Scene& scene_;
     const Octree& octree_;
     SolverOptions options_;
-    DualTable dual_;
+    /// Per surface the order m of its fields (surface_order: its own, else options.receiver.m).
+    std::vector<int> order_;
+    /// DN_m for every order m in use, built once (index m; null for an order no surface has).
+    std::vector<std::unique_ptr<DualTable>> duals_;
     Solution solution_;
     std::vector<std::vector<std::uint64_t>> split_cells_;  // per surface: cells split in some tree
     /// coupling_[j][i]: the power (per channel) surface i received from all of j's shots, and

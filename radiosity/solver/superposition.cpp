@@ -114,10 +114,17 @@ Solution combine(const std::vector<const Solution*>& solutions,
         MBR_CHECK_MSG(solutions[g]->radiosity.size() == n && solutions[g]->unshot.size() == n,
                       "solution " << g << " has " << solutions[g]->radiosity.size()
                                   << " surfaces, the first " << n);
-        // B and H fields do not add: a surface holds the same quantity in every solution.
-        for (size_t i = 0; i < n; ++i)
+        // B and H fields do not add: a surface holds the same quantity in every solution; and
+        // fields of two orders do not add either: a surface has one order in every solution
+        // (the surfaces' orders may differ, SceneSurface::order).
+        for (size_t i = 0; i < n; ++i) {
             MBR_CHECK_MSG(quantity_of(*solutions[g], i) == quantity_of(*solutions[0], i),
                           "surface " << i << " holds another quantity in solution " << g);
+            MBR_CHECK_MSG(solutions[g]->radiosity[i].order() == solutions[0]->radiosity[i].order(),
+                          "surface " << i << " has order " << solutions[g]->radiosity[i].order()
+                                     << " in solution " << g << ", "
+                                     << solutions[0]->radiosity[i].order() << " in the first");
+        }
     }
     // DESIGN: the sum starts as a copy of the first solution, so that every per-surface member
     // of Solution that is not a field (quantity: what a field holds, ...) is carried over as it
