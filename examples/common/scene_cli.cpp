@@ -17,6 +17,7 @@
 #include "radiosity/scene/scene_io.h"
 #include "radiosity/scene/scene_octree.h"
 #include "radiosity/solver/cost.h"
+#include "radiosity/solver/resolution.h"
 
 #ifdef _OPENMP
 #include <omp.h>
@@ -219,6 +220,9 @@ private:
 }  // namespace
 
 Solution solve_scene(SceneRun& run, bool progress) {
+    // A receiver too coarse for a light's peak is an error before the first shot, not a dark
+    // picture after it (radiosity/solver/resolution.h).
+    check_resolution(run.scene, run.options.receiver.max_depth);
     ProgressBar bar(progress && !run.quiet);
     return solve(run.scene, *run.octree, run.options,
                  [&](const ShotStats& shot, const ProgressiveSolver& solver) {

@@ -98,7 +98,8 @@ bool interpolation_agrees(const Oracle& o, const Rect& r, int thread, long* eval
     return true;
 }
 
-/// Distance from x to a planar shooter's closed polygon (its frame and outline).
+}  // namespace
+
 double distance_to_shooter(const ShooterPlane& plane, Vec3 x) {
     const double height = dot(x - plane.origin, plane.normal);
     const Vec2 q = plane.to_plane(x);
@@ -117,6 +118,8 @@ double distance_to_shooter(const ShooterPlane& plane, Vec3 x) {
     }
     return std::sqrt(height * height + across * across);
 }
+
+namespace {
 
 /// The contact rule (beyond the paper, ReceiverOptions::contact_depth and contact_oracle_test):
 /// true when the receiver's cell comes within half its size of a planar shooter: its corners,

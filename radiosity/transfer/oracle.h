@@ -14,4 +14,8 @@ namespace mbr {
 /// max_depth bound the tree.
 void subdivide_by_oracle(ReceiverState& state, IncrementSampler& sampler);
 
+/// Distance from x to a planar shooter's closed polygon (its frame and outline): the contact
+/// rule's measure (and the resolution check's, radiosity/solver/resolution.h).
+double distance_to_shooter(const ShooterPlane& plane, Vec3 x);
+
 }  // namespace mbr
