@@ -335,13 +335,13 @@ namespace fs = std::filesystem;
 using Catch::Matchers::Contains;
 using mbr::test::TempFolder;
 
-// The scene above, shallower still (max_depth 2, at most 4 shots) and with a 24 x 18 camera, so
-// that each run of the tool takes a fraction of a second.
+// The scene above with at most 4 shots and a 24 x 18 camera, so that each run of the tool takes
+// a fraction of a second. (Not shallower: at max_depth 2 the floor's cells, 0.5 wide, cannot hold
+// the side lamp's spot, 0.5 wide, and the tool refuses the scene: radiosity/solver/resolution.h.)
 std::string tool_scene() {
     std::string s = two_lamps_scene;
     for (const auto& [from, to] :
-         {std::pair<std::string, std::string>{"set max_depth 3", "set max_depth 2"},
-          {"set max_shots 20", "set max_shots 4"},
+         {std::pair<std::string, std::string>{"set max_shots 20", "set max_shots 4"},
           {"size 64 48", "size 24 18"}}) {
         const size_t at = s.find(from);
         REQUIRE(at != std::string::npos);
