@@ -66,10 +66,19 @@ CostEstimate transfer_cost(const ReceiverOptions& o) {
 }
 
 CostEstimate scene_cost(const Scene& scene, const SolverOptions& options, int threads) {
-    const int m = options.receiver.m, d = options.receiver.max_depth;
+    const int d = options.receiver.max_depth;
     const double n_surfaces = double(scene.surfaces.size());
-    // Radiosity and unshot per surface, and every receiver's result of one shot held at once.
-    const double fields = 3 * n_surfaces * field_bytes(m, d);
+    // Radiosity and unshot per surface, and every receiver's result of one shot held at once,
+    // each in its surface's order; a transfer's scratch at the largest order in use.
+    double fields = 0, seconds = 0;
+    int m = 0;
+    for (int i = 0; i < static_cast<int>(scene.surfaces.size()); ++i) {
+        const int mi = surface_order(scene, i, options.receiver.m);
+        fields += 3 * field_bytes(mi, d);
+        seconds += transfer_seconds(mi, d);  // one shot's transfers, each a full tree
+        m = std::max(m, mi);
+    }
+    if (m == 0) m = options.receiver.m;  // no surfaces
     // Transfers run one per thread over the receivers, except with the paper's fractions,
     // which run one transfer at a time, parallel inside.
     const bool one_at_a_time = options.receiver.shadows.method == ShadowMethod::Fractions;
@@ -94,7 +103,7 @@ CostEstimate scene_cost(const Scene& scene, const SolverOptions& options, int th
         }
     CostEstimate c;
     c.bytes = fields + transfers + polygons + textures;
-    c.seconds = n_surfaces * transfer_seconds(m, d);  // one shot's transfers, each a full tree
+    c.seconds = seconds;
     c.detail = "fields " + format_bytes(fields) + ", transfers " + format_bytes(transfers) +
                ", polygons " + format_bytes(polygons) + ", textures " + format_bytes(textures);
     return c;
