@@ -194,4 +194,8 @@ TEST_CASE("options: solver_options turns each choice into the solver's own", "[o
     CHECK(d.receiver.unify_by_projection);
     CHECK(d.receiver.extrapolation == Extrapolation::Linear);
     CHECK(d.receiver.contact_oracle_test == OracleTest::Means);
+    CHECK(d.receiver.shadows.kernel_weighted);  // `set fraction_rays kernel`, the default
+    s.fraction_rays = FractionRaysSetting::Area;
+    CHECK_FALSE(solver_options(s).receiver.shadows.kernel_weighted);
+    CHECK_FALSE(ShadowOptions{}.kernel_weighted);  // a transfer of its own keeps the paper's
 }

@@ -36,6 +36,12 @@ enum class ContactOracleSetting {
     Means           // "means": the paper's two means
 };
 
+/// How a fraction (28) counts the rays to one patch of the shooter.
+enum class FractionRaysSetting {
+    Kernel,  // "kernel": each ray weighted by the kernel (3) times A (4) at its end
+    Area     // "area": the share of rays that arrive (the paper's)
+};
+
 /// What a surface with a textured reflectance stores as its spline field.
 enum class TextureFieldSetting {
     Irradiance,  // "irradiance": H, with B = E + rho H formed at samples and pixels
@@ -68,6 +74,7 @@ struct SolverSettings {
                             //   least this level (0: off)
     ContactOracleSetting contact_oracle = ContactOracleSetting::Means;
     TextureFieldSetting texture_field = TextureFieldSetting::Irradiance;
+    FractionRaysSetting fraction_rays = FractionRaysSetting::Kernel;
 };
 
 /// One row of the option table.

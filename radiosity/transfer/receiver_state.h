@@ -35,6 +35,9 @@ struct ShadowOptions {
     double threshold = 0.05;  // fractions of neighbouring fulcrums differing by more split the
                               //   leaves between them (largest channel)
     int max_depth = 6;        // shadow subdivision stops at leaves of this level
+    bool kernel_weighted = false;  // beyond the paper: r_i of (28) weights each ray by the
+                                   //   kernel (3) times A (4) at its end (scenes: `set
+                                   //   fraction_rays kernel`, their default)
 };
 
 /// The partition of a fraction (28) is at least this deep: the adaptive quadrature of (21) run

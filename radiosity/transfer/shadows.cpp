@@ -14,6 +14,7 @@
 #include "math/check.h"
 #include "math/parallel.h"
 #include "radiosity/geometry/spline_field.h"
+#include "radiosity/transfer/form_factor.h"
 #include "radiosity/transfer/projection.h"
 #include "radiosity/transfer/scale_adjustment.h"
 #include "radiosity/transfer/unification.h"
@@ -86,7 +87,14 @@ Rgb compute_fraction(const ReceiverState& state, IncrementSampler& sampler, Vec2
         const Rgb e = patch.value;  // energy the patch shoots toward p
         if (max_abs(e) == 0) continue;
         const std::uint64_t key = hash_seed(point_key, i);
-        int visible = 0;
+        // r_i: the share of rays that arrive (the paper's), or beyond the paper
+        // (ShadowOptions::kernel_weighted) each ray counted with the kernel (3) times A (4) at
+        // its end, the visible share of what the patch sends to p. DESIGN: the area share
+        // darkens a point whose kernel peaks on the visible part of a patch that the shadow
+        // cuts (a block's face by the floor it stands on: the Cornell box's short block read
+        // -5.6 % with paper shadows, 1.1 % with the kernel's weights).
+        const bool weighted = state.options.shadows.kernel_weighted;
+        double visible = 0, weight = 0;
         // DESIGN: when the count is a square, the random points are jittered on a grid of as
         // many strata (2 x 2 for the default 4): still uniform over the patch, less variance.
         const int side = static_cast<int>(std::lround(std::sqrt(double(n_rays_per_patch))));
@@ -98,12 +106,24 @@ Rgb compute_fraction(const ReceiverState& state, IncrementSampler& sampler, Vec2
                 a = (k % side + a) / side;
                 b = (k / side + b) / side;
             }
-            const Vec3 x = shooter.point(c.x0 + a * c.width(), c.y0 + b * c.height());
+            const double u = c.x0 + a * c.width(), v = c.y0 + b * c.height();
+            double w = 1;
+            Vec3 x;
+            if (weighted) {
+                const SurfacePoint q = shooter.evaluate(u, v);
+                x = q.position;
+                w = form_factor_kernel(p.position, p.normal, q.position, q.normal) * q.area_factor;
+                if (!(w > 0)) continue;
+            } else {
+                x = shooter.point(u, v);
+            }
+            weight += w;
             const bool blocked = plane ? segment_blocked(ctx, toward, p.position, x, n_rays)
                                        : segment_blocked(ctx, p.position, x, n_rays);
-            if (!blocked) ++visible;
+            if (!blocked) visible += w;
         }
-        num += (double(visible) / n_rays_per_patch) * e;
+        if (!(weight > 0)) continue;  // no ray ends where the patch shoots toward p
+        num += (visible / weight) * e;
         den += e;
     }
     Rgb f;
