@@ -17,6 +17,7 @@
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <ostream>
 #include <sstream>
 #include <string>
@@ -42,8 +43,7 @@ inline std::ostream& operator<<(std::ostream& os, const ProgramRun& r) {
 class TempFolder {
 public:
     TempFolder() {
-        std::string pattern =
-            (std::filesystem::temp_directory_path() / "mbr test XXXXXX").string();
+        std::string pattern = (std::filesystem::temp_directory_path() / "mbr test XXXXXX").string();
         REQUIRE(::mkdtemp(pattern.data()) != nullptr);
         path_ = pattern;
     }
@@ -56,6 +56,12 @@ public:
 
     std::string operator/(const std::string& name) const { return (path_ / name).string(); }
     const std::filesystem::path& path() const { return path_; }
+    /// Writes `text` to the file `name` in the folder (bytes as given) and returns its path.
+    std::string write(const std::string& name, const std::string& text) const {
+        const std::string p = (path_ / name).string();
+        std::ofstream(p, std::ios::binary) << text;
+        return p;
+    }
 
 private:
     std::filesystem::path path_;
@@ -63,8 +69,7 @@ private:
 
 /// An anonymous file for one captured stream (unlinked at once; the descriptor keeps it).
 inline int capture_file() {
-    std::string name =
-        (std::filesystem::temp_directory_path() / "mbr capture XXXXXX").string();
+    std::string name = (std::filesystem::temp_directory_path() / "mbr capture XXXXXX").string();
     const int fd = ::mkstemp(name.data());
     REQUIRE(fd >= 0);
     ::unlink(name.c_str());

@@ -57,25 +57,6 @@ const std::string materials =
     "material white reflectance 0.5 0.5 0.5\n"
     "material red reflectance 0.6 0.1 0.1\n";
 
-/// A scratch folder, removed at the end of the test.
-struct TempDir {
-    std::filesystem::path path;
-    TempDir() {
-        path = std::filesystem::temp_directory_path() /
-               ("mbr_test_duplicate_faces_" + std::to_string(long(getpid())));
-        std::filesystem::create_directories(path);
-    }
-    ~TempDir() {
-        std::error_code ec;
-        std::filesystem::remove_all(path, ec);
-    }
-    std::string write(const std::string& name, const std::string& text) const {
-        const std::string p = (path / name).string();
-        std::ofstream(p) << text;
-        return p;
-    }
-};
-
 }  // namespace
 
 // ---------------------------------------------------------------------------------------------
@@ -247,7 +228,7 @@ TEST_CASE("duplicate faces: one warning for many repeats, naming the first", "[d
 }
 
 TEST_CASE("duplicate faces: an OBJ repeat with another material is an error", "[duplicate_faces]") {
-    TempDir dir;
+    mbr::test::TempFolder dir;
     dir.write("m.mtl", "newmtl white\nKd 0.5 0.5 0.5\nnewmtl red\nKd 0.6 0.1 0.1\n");
     const std::string obj = dir.write("m.obj",
                                       "mtllib m.mtl\n"
@@ -262,7 +243,7 @@ TEST_CASE("duplicate faces: an OBJ repeat with another material is an error", "[
 }
 
 TEST_CASE("duplicate faces: an OBJ face that repeats a scene surface", "[duplicate_faces]") {
-    TempDir dir;
+    mbr::test::TempFolder dir;
     const std::string obj =
         dir.write("part.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 2 3 4 1\n");
     SECTION("the same material (obj_default): dropped, naming both files' lines") {

@@ -22,6 +22,7 @@
 #include "radiosity/solver/solver.h"
 #include "radiosity/solver/superposition.h"
 #include "test/report.h"
+#include "test/run_program.h"
 
 using namespace mbr;
 using Catch::Matchers::Contains;
@@ -163,25 +164,6 @@ std::string replaced(std::string text, const std::string& from, const std::strin
     return text.replace(at, from.size(), to);
 }
 
-/// A folder of scratch files, removed at the end of the test.
-struct TempDir {
-    std::filesystem::path path;
-    TempDir() {
-        path = std::filesystem::temp_directory_path() /
-               ("mbr_test_mixed_order_" + std::to_string(long(getpid())));
-        std::filesystem::create_directories(path);
-    }
-    ~TempDir() {
-        std::error_code ec;
-        std::filesystem::remove_all(path, ec);
-    }
-    std::string write(const std::string& name, const std::string& text) const {
-        const std::string p = (path / name).string();
-        std::ofstream(p, std::ios::binary) << text;
-        return p;
-    }
-};
-
 const std::string white = "material white reflectance 0.5 0.5 0.5\n";
 const std::string numbers_12 = "0 0 0  1 0 0  1 1 0  0 1 0";
 
@@ -264,7 +246,7 @@ TEST_CASE("mixed_order: bad orders are refused at their line", "[mixed_order][er
 }
 
 TEST_CASE("mixed_order: an OBJ import takes one order for all its surfaces", "[mixed_order][obj]") {
-    const TempDir dir;
+    const mbr::test::TempFolder dir;
     dir.write("two.obj",
               "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\n"
               "o a\nf 1 2 3 4\no b\nf 1 5 6 2\n");
@@ -282,7 +264,7 @@ TEST_CASE("mixed_order: an OBJ import takes one order for all its surfaces", "[m
         load_scene(dir.write("bad.scene", "obj two.obj order 12\n"));
         FAIL("no InputError");
     } catch (const InputError& e) {
-        CHECK(e.file() == (dir.path / "bad.scene").string());
+        CHECK(e.file() == dir / "bad.scene");
         CHECK(e.line() == 1);
         CHECK_THAT(e.message(), Contains("order must be an integer 2..8, found '12'"));
     }
