@@ -22,12 +22,14 @@
 #include "radiosity/solver/solution_file.h"
 #include "radiosity/solver/solver.h"
 #include "test/report.h"
+#include "test/solution_text.h"
 #ifdef MBR_TOOL
 #include "test/run_program.h"
 #endif
 
 using namespace mbr;
 using Catch::Matchers::Contains;
+using mbr::test::saved;
 
 namespace {
 
@@ -327,12 +329,6 @@ SolverOptions quick(const Scene& scene) {
 Solution solved(const Scene& scene) {
     const Octree octree = build_octree(scene);
     return solve(scene, octree, quick(scene));
-}
-
-std::string saved(const Scene& scene, const Solution& solution) {
-    std::ostringstream os;
-    save_solution(os, scene, solution);
-    return os.str();
 }
 
 }  // namespace

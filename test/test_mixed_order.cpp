@@ -23,9 +23,12 @@
 #include "radiosity/solver/superposition.h"
 #include "test/report.h"
 #include "test/run_program.h"
+#include "test/solution_text.h"
 
 using namespace mbr;
 using Catch::Matchers::Contains;
+using mbr::test::same_fields;
+using mbr::test::saved;
 
 namespace {
 
@@ -131,19 +134,6 @@ double total_power(const Solved& s) {
         sum += (p.r + p.g + p.b) / 3;
     }
     return sum;
-}
-
-bool same_fields(const SplineField& a, const SplineField& b) {
-    if (a.order() != b.order() || a.level() != b.level()) return false;
-    for (int c = 0; c < 3; ++c)
-        if (a.channel(c).a != b.channel(c).a) return false;
-    return true;
-}
-
-std::string saved(const Scene& scene, const Solution& solution) {
-    std::ostringstream os;
-    save_solution(os, scene, solution);
-    return os.str();
 }
 
 /// The message of the InputError that loading `text` throws (empty when it loads).

@@ -20,12 +20,15 @@
 #include "radiosity/visibility/hidden_regions.h"
 #include "radiosity/visibility/visible_parts.h"
 #include "test/report.h"
+#include "test/solution_text.h"
 
 #ifdef _OPENMP
 #include <omp.h>
 #endif
 
 using namespace mbr;
+using mbr::test::same_fields;
+using mbr::test::saved;
 
 namespace {
 
@@ -78,19 +81,6 @@ SolverOptions quick_options(const Scene& scene, int max_shots) {
     o.max_shots = max_shots;
     o.convergence = 0;
     return o;
-}
-
-bool same_fields(const SplineField& a, const SplineField& b) {
-    if (a.order() != b.order() || a.level() != b.level()) return false;
-    for (int c = 0; c < 3; ++c)
-        if (a.channel(c).a != b.channel(c).a) return false;
-    return true;
-}
-
-std::string saved(const Scene& scene, const Solution& solution) {
-    std::ostringstream os;
-    save_solution(os, scene, solution);
-    return os.str();
 }
 
 /// The message of the InputError that loading `text` throws (empty when it loads).
