@@ -11,7 +11,8 @@
 //                        [solver options]
 // For each setting: solve seconds; mean and max luminance error over the points, and the mean
 // over the lit and the shadowed points (`in_shadow` column) apart; shots, coefficients, kernel
-// evaluations and rays. --csv prints `setting,seconds,mean_err_percent,max_err_percent,shots,
+// evaluations and rays; the lowest value of B on a 129 x 129 (u, v) grid of every surface
+// and where. --csv prints `setting,seconds,mean_err_percent,max_err_percent,shots,
 // coefficients`. --points FILE reads another points file with the same columns (name, x, y, z,
 // nx, ny, nz, B_r, B_g, B_b; in_shadow optional). -o DIR writes DIR/cornell_<setting>.png (the
 // render) and DIR/cornell_<setting>_error.png (the error against the reference image
@@ -23,6 +24,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <limits>
 #include <map>
 #include <sstream>
 
@@ -129,9 +131,32 @@ struct Result {
     std::string setting;
     double seconds = 0, mean = 0, max = 0, mean_lit = 0, mean_shadow = 0;
     std::string worst;
+    double lowest = 0;   // lowest channel value on a 129 x 129 (u, v) grid of every surface
+    std::string lowest_at;
     SolveStats stats;
     std::vector<double> errors;  // signed, per point
 };
+
+/// The lowest value of any channel of B over a 129 x 129 grid of (u, v) on every surface (the
+/// corners included), and where: radiosity is never negative (issue 19's target).
+void lowest_value(const Scene& scene, const RadiosityView& view, Result& r) {
+    const int n = 129;
+    r.lowest = std::numeric_limits<double>::infinity();
+    for (int i = 0; i < view.size(); ++i) {
+        if (view.empty(i)) continue;
+        for (int a = 0; a < n; ++a)
+            for (int b = 0; b < n; ++b) {
+                const Rgb B = view.at(i, double(a) / (n - 1), double(b) / (n - 1));
+                const double v = std::min({B[0], B[1], B[2]});
+                if (v < r.lowest) {
+                    r.lowest = v;
+                    std::ostringstream where;
+                    where << scene.surfaces[i].name << "(" << a << "/128," << b << "/128)";
+                    r.lowest_at = where.str();
+                }
+            }
+    }
+}
 
 /// The reference image (256 x 256, linear radiance clipped at 1 and raised to 1/2.2).
 std::vector<double> reference_image(const std::string& path, int& w, int& h) {
@@ -203,6 +228,7 @@ int run(Args& args) {
             ++(ref[i].in_shadow ? n_shadow : n_lit);
         }
         r.mean /= double(ref.size());
+        lowest_value(run.scene, view, r);
         if (n_lit) r.mean_lit /= n_lit;
         if (n_shadow) r.mean_shadow /= n_shadow;
         results.push_back(r);
@@ -249,14 +275,14 @@ int run(Args& args) {
     std::cout << "Cornell box against " << points_path << " (" << ref.size()
               << " points; luminance error |Y / Y_ref - 1|)\n\n";
     Table t({"setting", "seconds", "mean_%", "max_%", "worst", "lit_%", "shadow_%", "shots",
-             "unshot_%", "coefficients", "kernel_evals", "rays"});
+             "unshot_%", "coefficients", "kernel_evals", "rays", "lowest", "lowest_at"});
     for (const Result& r : results)
         t.add_row({r.setting, cell(r.seconds, 2), cell(100 * r.mean, 2), cell(100 * r.max, 2),
                    r.worst, cell(100 * r.mean_lit, 2), cell(100 * r.mean_shadow, 2),
                    std::to_string(r.stats.shots),
                    cell_g(100 * r.stats.unshot_power / r.stats.emitted_power, 3),
                    std::to_string(r.stats.coefficients), std::to_string(r.stats.kernel_evals),
-                   std::to_string(r.stats.rays)});
+                   std::to_string(r.stats.rays), cell_g(r.lowest, 3), r.lowest_at});
     t.write_text(std::cout);
     if (per_point) {
         std::vector<std::string> cols{"point", "in_shadow", "Y_ref"};

@@ -10,6 +10,7 @@
 // "Textured reflectance").
 #pragma once
 
+#include <memory>
 #include <utility>
 #include <vector>
 
@@ -33,13 +34,17 @@ struct ShadedField {
 };
 
 /// B_i(u, v) for every surface i of a solution. Holds pointers: the fields and textures must
-/// outlive the view. A plain list of fields converts implicitly (every field then holds B).
+/// outlive the view (except the fields it owns). A plain list of fields converts implicitly (every field then holds B).
 class RadiosityView {
 public:
     RadiosityView() = default;
     /// Every field holds B.
     RadiosityView(const std::vector<SplineField>& radiosity);  // NOLINT: implicit on purpose
-    explicit RadiosityView(std::vector<ShadedField> surfaces) : surfaces_(std::move(surfaces)) {}
+    /// `owned` keeps fields alive that `surfaces` point into (copies the view made), shared by
+    /// the view's copies.
+    explicit RadiosityView(std::vector<ShadedField> surfaces,
+                           std::shared_ptr<const std::vector<SplineField>> owned = nullptr)
+        : surfaces_(std::move(surfaces)), owned_(std::move(owned)) {}
 
     int size() const { return static_cast<int>(surfaces_.size()); }
     /// True when surface i has no field (it is then black).
@@ -50,6 +55,7 @@ public:
 
 private:
     std::vector<ShadedField> surfaces_;
+    std::shared_ptr<const std::vector<SplineField>> owned_;
 };
 
 }  // namespace mbr

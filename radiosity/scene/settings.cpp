@@ -127,10 +127,11 @@ std::vector<OptionSpec> make_option_table() {
                       "at the end, the power still unshot is sent on through the measured "
                       "coupling of the surfaces (an ambient term)"),
         switch_option("limiter", &S::limiter,
-                      "each shot's increments have their coefficients clipped to [0, rho_max x "
-                      "the shooter's largest coefficient]: the field then never rings below "
-                      "zero nor above the physical bound, but moves the Cornell box's points by "
-                      "up to 1.8 % (docs/method.md); off is the paper's"),
+                      "where a shot's increment rings above rho_max x the shooter's largest "
+                      "coefficient its covering coefficients are clipped to that bound, and "
+                      "pictures and probes read the fields lifted to zero where they ring "
+                      "below it: radiosity is never negative (docs/method.md); off is the "
+                      "paper's"),
         switch_option("hidden", &S::hidden,
                       "points that see no front face of the scene take their nearest visible "
                       "neighbour's value"),

@@ -67,7 +67,7 @@ struct SolverSettings {
     double tolerance = 2e-3;  // accuracy relative to the scene's radiosity scale
     UnifySetting unify = UnifySetting::Projection;
     bool ambient = true;    // ambient correction of the unshot power at the end
-    bool limiter = false;   // increments clipped to their physical bounds
+    bool limiter = true;    // increments and final fields clipped to their physical bounds
     bool hidden = true;     // hidden regions take their visible neighbours' values
     int shooter_level = 3;  // a shooter's unshot field coarsened to at most this level
     int contact_depth = 2;  // receiver cells touching a planar shooter split to at

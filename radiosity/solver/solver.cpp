@@ -243,47 +243,6 @@ SplineField project_emission(const Texture& emission, int m, int level) {
                          level);
 }
 
-void limit_increment(SplineField& field, Rgb upper, double slack) {
-    if (field.empty()) return;
-    // Where the field leaves its bounds: at the corners, edge midpoints and centre of every
-    // level-j cell (2^(j+1) + 1 points a direction).
-    const int j = field.level(), m = field.order(), cells = 1 << j, n = 2 * cells + 1;
-    std::vector<double> x(n);
-    for (int a = 0; a < n; ++a) x[a] = double(a) / (n - 1);
-    std::vector<Rgb> values(size_t(n) * n);
-    field.evaluate_grid(x.data(), n, x.data(), n, values.data());
-    for (int c = 0; c < 3; ++c) {
-        const double hi = std::max(0.0, upper[c]);
-        std::vector<char> outside(size_t(cells) * cells, 0);  // per cell
-        bool any = false;
-        for (int a = 0; a < n; ++a)
-            for (int b = 0; b < n; ++b) {
-                const double v = values[size_t(a) * n + b][c];
-                if (v >= -slack && v <= hi + slack) continue;
-                any = true;
-                // The point belongs to the cells around it.
-                for (int ci = std::max(0, (a - 1) / 2); ci <= std::min(cells - 1, a / 2); ++ci)
-                    for (int cj = std::max(0, (b - 1) / 2); cj <= std::min(cells - 1, b / 2); ++cj)
-                        outside[size_t(ci) * cells + cj] = 1;
-            }
-        if (!any) continue;
-        // Clip the coefficients whose B-spline covers such a cell: N(2^j s - k) lives on cells
-        // k .. k + m - 1.
-        CoefficientGrid& g = field.channel(c);
-        for (int k = g.first_k; k < g.first_k + g.n_k; ++k)
-            for (int l = g.first_l; l < g.first_l + g.n_l; ++l) {
-                bool covers = false;
-                for (int ci = std::max(0, k); ci <= std::min(cells - 1, k + m - 1) && !covers; ++ci)
-                    for (int cj = std::max(0, l); cj <= std::min(cells - 1, l + m - 1); ++cj)
-                        if (outside[size_t(ci) * cells + cj]) {
-                            covers = true;
-                            break;
-                        }
-                if (covers) g(k, l) = std::clamp(g(k, l), 0.0, hi);
-            }
-    }
-}
-
 Rgb coefficient_bound(const SplineField& field) {
     Rgb bound;
     for (int c = 0; c < 3; ++c)
@@ -299,10 +258,18 @@ RadiosityView radiosity_view(const Scene& scene, const Solution& solution) {
     const int n = static_cast<int>(solution.radiosity.size());
     MBR_CHECK(n == static_cast<int>(scene.surfaces.size()));
     MBR_CHECK(solution.quantity.empty() || static_cast<int>(solution.quantity.size()) == n);
+    // The scene's limiter setting makes what is viewed never negative (limit_positive), on
+    // copies: the solution itself stays linear in the emission, so that light groups'
+    // solutions add (superposition.h) before they are made positive.
+    std::shared_ptr<std::vector<SplineField>> positive;
+    if (scene.settings.limiter) {
+        positive = std::make_shared<std::vector<SplineField>>(solution.radiosity);
+        for (SplineField& f : *positive) limit_positive(f);
+    }
     std::vector<ShadedField> surfaces(n);
     for (int i = 0; i < n; ++i) {
         ShadedField& s = surfaces[i];
-        s.field = &solution.radiosity[i];
+        s.field = positive ? &(*positive)[i] : &solution.radiosity[i];
         if (!solution.quantity.empty()) s.quantity = solution.quantity[i];
         if (s.quantity == FieldQuantity::irradiance) {
             const Material& mat = scene.material_of(i);
@@ -310,7 +277,7 @@ RadiosityView radiosity_view(const Scene& scene, const Solution& solution) {
             if (mat.emits()) s.emission = &mat.emission;
         }
     }
-    return RadiosityView(std::move(surfaces));
+    return RadiosityView(std::move(surfaces), std::move(positive));
 }
 
 // ---- The loop -----------------------------------------------------------------------------

@@ -27,6 +27,7 @@
 #include "radiosity/geometry/radiosity_view.h"
 #include "radiosity/geometry/spline_field.h"
 #include "radiosity/scene/scene.h"
+#include "radiosity/solver/limiter.h"
 #include "radiosity/transfer/transfer.h"
 #include "radiosity/visibility/hidden_regions.h"
 
@@ -53,7 +54,9 @@ struct SolverOptions {
                                     //   level (the paper's "lower resolution version", section
                                     //   6); the receiver options' shooter_coarsening levels at
                                     //   least (levels 4 and 5 measured: docs/method.md)
-    bool limiter = false;           // beyond the paper: increments clipped to [0, rho_max max B_h]
+    bool limiter = true;            // beyond the paper: increments clipped to at most
+                                    //   rho_max max B_h (limiter.h; radiosity_view makes what
+                                    //   is viewed non-negative by the scene's setting)
     bool irradiance_fields = true;  // beyond the paper: a surface with a textured reflectance
                                     //   stores H (B = E + rho H, radiosity_view.h)
     bool ambient = true;            // beyond the paper: at the end, the power still unshot is
@@ -89,8 +92,8 @@ struct ShotStats {
     double incident = 0;       // power arriving: sum_i int dB_i A / rho_i (constant rho)
     int receivers = 0;         // transfers made
     long kernel_evals = 0;     // evaluations of (3) in all its transfers
-    double limited = 0;        // power the limiter added (clipping up from below zero) minus
-                               //   what it removed (clipping down), sum of channels
+    double limited = 0;        // power the limiter changed (clipping overshoots down: <= 0),
+                               //   sum of channels
     long rays = 0;             // shadow rays
     int finest_level = 0;      // finest level of its results
     double seconds = 0;
@@ -107,7 +110,7 @@ struct SolveStats {
     long coefficients = 0;       // coefficients of the solved fields (all surfaces, per channel)
     long kernel_evals = 0, rays = 0;
     double ambient_power = 0;  // power the ambient correction added (sum of channels)
-    double limited_power = 0;  // the limiter's net change of the reflected power, all shots
+    double limited_power = 0;  // the limiter's change of the reflected power, all shots (<= 0)
     std::vector<ShotStats> per_shot;
 };
 
@@ -123,21 +126,12 @@ struct Solution {
     SolveStats stats;
 };
 
-/// The limiter (beyond the paper): every increment of a shot lies in [0, rho_max max B_h]
-/// (light only adds, and H(x) = int F B_h dA <= max B_h since int F dA <= 1), but the dual
-/// projection of a step the quadtree does not resolve overshoots and rings below zero. Clipping
-/// the coefficients to bounds keeps the field in them: the B-splines are non-negative and sum
-/// to one, so the field is a convex combination of its coefficients. Where the field leaves
-/// [-slack, upper + slack] (checked at the corners, edge midpoints and centres of its cells),
-/// the coefficients of the B-splines covering those cells are clipped to [0, upper], per
-/// channel; elsewhere the field is unchanged (a smaller violation is within the transfer's
-/// tolerance, and clipping the coefficients that lie beyond the domain's edges, which may be
-/// negative in a positive field, would move it by more).
-void limit_increment(SplineField& field, Rgb upper, double slack);
 /// Per channel the largest coefficient of `field`, at least 0: a bound of the field's values.
 Rgb coefficient_bound(const SplineField& field);
 
-/// B_i(u, v) of every surface of a solution of `scene` (both must outlive the view).
+/// B_i(u, v) of every surface of a solution of `scene` (both must outlive the view). With the
+/// scene's `limiter` setting on, the view reads copies of the fields made non-negative by
+/// limit_positive; the solution is unchanged.
 RadiosityView radiosity_view(const Scene& scene, const Solution& solution);
 
 /// True when surface i of `scene` stores H under `options` (a textured reflectance with

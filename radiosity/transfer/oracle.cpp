@@ -136,6 +136,39 @@ bool touches_shooter(const Surface& receiver, const ShooterPlane& plane, const R
     return false;
 }
 
+/// The hover rule (beyond the paper, part of the contact rule): true when the receiver's cell
+/// faces a planar shooter nearly parallel to it (normals within about 25 degrees of opposite)
+/// from closer than half its own size, and some of its corners, edge midpoints and centre,
+/// projected onto the shooter's plane, come within half the cell's size of the shooter's
+/// outline. Under a shooter hovering at height d, dB steps at the outline's shadow over a
+/// width of about d (a light 1e-4 above a floor: from rho E to rho E / 2 to 0), which no cell
+/// wider than that resolves and whose two means agree on either side.
+bool hovers_at_outline(const Surface& receiver, const ShooterPlane& plane, const Rect& r) {
+    const SurfacePoint centre = receiver.evaluate(0.5 * (r.x0 + r.x1), 0.5 * (r.y0 + r.y1));
+    if (dot(centre.normal, plane.normal) > -0.9) return false;
+    Vec3 p[9];
+    int k = 0;
+    for (double t : {r.y0, 0.5 * (r.y0 + r.y1), r.y1})
+        for (double s : {r.x0, 0.5 * (r.x0 + r.x1), r.x1})
+            p[k++] = receiver.evaluate(s, t).position;
+    const double size = std::max(length(p[8] - p[0]), length(p[6] - p[2]));
+    const size_t n = plane.outline.size();
+    for (const Vec3& x : p) {
+        const double height = dot(x - plane.origin, plane.normal);
+        if (height < 0 || height > 0.5 * size) continue;
+        const Vec2 q = plane.to_plane(x);
+        for (size_t e = 0; e < n; ++e) {
+            const Vec2 a = plane.outline[e], b = plane.outline[(e + 1) % n];
+            const Vec2 d = b - a;
+            const double len2 = dot(d, d);
+            const double t = len2 > 0 ? std::clamp(dot(q - a, d) / len2, 0.0, 1.0) : 0.0;
+            const Vec2 off = q - (a + t * d);
+            if (dot(off, off) <= 0.25 * size * size) return true;
+        }
+    }
+    return false;
+}
+
 /// The weak receiver rule (DESIGN, cost follows energy): a receiver whose largest root sample
 /// is below weak_receiver times the absolute tolerance starts the oracle at the root.
 int weak_receiver_min_depth(const ReceiverOptions& opt, double scale) {
@@ -160,6 +193,9 @@ OracleAction oracle_action(const Oracle& o, const DyadicCell& cell, long* evals,
         ask && touches_shooter(*o.sampler.receiver().surface, *o.contact_plane, cell.rect());
     if (cell.level < opt.contact_depth && contact) return OracleAction::Split;
     if (cell.level >= opt.max_depth) return OracleAction::Leaf;
+    if (o.contact_plane && opt.contact_depth > 0 &&
+        hovers_at_outline(*o.sampler.receiver().surface, *o.contact_plane, cell.rect()))
+        return OracleAction::Split;
     const int th = thread_index();
     // DESIGN: a cell touching the shooter takes contact_oracle_test (`set contact_oracle
     // interpolation`): there dB grows like d log d, whose two means agree long before the
