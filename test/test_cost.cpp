@@ -61,7 +61,9 @@ TEST_CASE("cost: the estimate grows with depth, order and tessellation", "[cost]
     o.receiver.max_depth = 6;
     const double at_24 = scene_cost(scene, o, 2).bytes;
     scene.settings.tessellation = 1024;
-    CHECK(scene_cost(scene, o, 2).bytes > 100 * at_24);  // 1024^2 / 24^2 more curved facets
+    // 1024^2 / 24^2 more curved facets: the polygons (2.3 MiB at 24) outgrow the rest (the
+    // program, fields, hidden regions and quadrature caches: about 68 MiB in all).
+    CHECK(scene_cost(scene, o, 2).bytes > 50 * at_24);
 }
 
 TEST_CASE("cost: a run over the memory budget is refused before it starts", "[cost]") {

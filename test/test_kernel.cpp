@@ -520,3 +520,40 @@ TEST_CASE("kernel: the closed form for constant shooters", "[kernel]") {
         }
     }
 }
+
+TEST_CASE("kernel: the quadrature's point cache stays within its bound and never changes values",
+          "[kernel]") {
+    // Receiving points 1e-4 in front of a unit square, each at another place: every point
+    // splits the shooter deep around its foot, so the cells seen add up to more points than
+    // max_cached_points, and the cache starts over (the bound the memory estimate counts,
+    // cost.h). Before the bound was tied to the estimate, the pool grew to 2^20 points and
+    // past them by doubling (the room peaked at 195 MiB).
+    const Surface quad = Surface::planar_quad({0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0});
+    Shooter shooter;
+    shooter.surface = &quad;
+    shooter.unshot = SplineField::constant(4, 0, {1, 1, 1});
+    QuadratureOptions options;
+    options.analytic = false;  // the closed form caches nothing
+    IncrementIntegrator warm(shooter, options);
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<double> u(0.01, 0.99);
+    std::vector<SurfacePoint> points;
+    for (int k = 0; k < 600; ++k)
+        points.push_back({{u(rng), u(rng), 1e-4}, {0, 0, -1}, 1});
+    long evaluations = 0;
+    std::vector<Rgb> values;
+    for (const SurfacePoint& p : points) {
+        const IncrementIntegrator::Result r = warm.integrate(p);
+        evaluations += r.n_evaluations;
+        values.push_back(r.value);
+    }
+    test::report() << "cache: " << evaluations << " kernel evaluations, capacity "
+                   << warm.cached_point_capacity() << " points\n";
+    CHECK(evaluations > long(4 * max_cached_points));  // enough cells to fill it several times
+    CHECK(warm.cached_point_capacity() <= max_cached_points);
+    // The same points through fresh integrators give the same bits.
+    for (size_t k = 0; k < points.size(); k += 149) {
+        IncrementIntegrator fresh(shooter, options);
+        CHECK(fresh.integrate(points[k]).value == values[k]);
+    }
+}

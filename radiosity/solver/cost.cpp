@@ -36,6 +36,10 @@ constexpr double seconds_per_leaf = 2e-4;
 // facets, the polygons with their planes, and the octree's references and nodes.
 constexpr double bytes_per_polygon = 960;
 
+// The program before any scene: 6,488 KB resident (single_transfer --depth 0 above), 6.2-6.9 MB
+// for mbr probe of a small scene.
+constexpr double program_bytes = 8.0 * (1 << 20);
+
 }  // namespace
 
 double field_bytes(int m, int level) {
@@ -101,11 +105,25 @@ CostEstimate scene_cost(const Scene& scene, const SolverOptions& options, int th
             seen.push_back(t);
             textures += double(t->texel_bytes());
         }
+    // Every thread's integrator holds its shooter-point caches at their bound (sample_values.h),
+    // and the program itself (code, runtime, stack) comes first.
+    const double caches = double(std::max(1, threads)) * cached_points_bytes();
+    // Per surface: its hidden-region mask (a byte and a substitute point per texel), and a row
+    // of the measured coupling for every shooter that has shot (at most max_shots rows).
+    const double hidden =
+        options.hidden_regions
+            ? n_surfaces * hidden_resolution * hidden_resolution * (1.0 + sizeof(Vec2))
+            : 0.0;
+    const double coupling =
+        std::min(double(std::max(0, options.max_shots)), n_surfaces) * n_surfaces * sizeof(Rgb);
+    fields += coupling;
     CostEstimate c;
-    c.bytes = fields + transfers + polygons + textures;
+    c.bytes = program_bytes + fields + hidden + transfers + caches + polygons + textures;
     c.seconds = seconds;
-    c.detail = "fields " + format_bytes(fields) + ", transfers " + format_bytes(transfers) +
-               ", polygons " + format_bytes(polygons) + ", textures " + format_bytes(textures);
+    c.detail = "program " + format_bytes(program_bytes) + ", fields " + format_bytes(fields) +
+               ", hidden regions " + format_bytes(hidden) + ", transfers " + format_bytes(transfers) + ", quadrature caches " +
+               format_bytes(caches) + ", polygons " + format_bytes(polygons) + ", textures " +
+               format_bytes(textures);
     return c;
 }
 

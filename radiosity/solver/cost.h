@@ -32,10 +32,11 @@ double transfer_seconds(int m, int depth);
 /// One transfer with these options (the tree at options.max_depth: the uniform tree, or the
 /// adaptive tree's worst case).
 CostEstimate transfer_cost(const ReceiverOptions& options);
-/// A whole-scene solve: per surface its radiosity and unshot fields at the receiver's max depth,
-/// one shot's received fields, one transfer's working memory per thread (`threads` transfers at
-/// once, one with the paper's shadow fractions), the tessellation's polygons and octree, and each
-/// distinct texture image once.
+/// A whole-scene solve: the program itself; per surface its radiosity and unshot fields at the
+/// receiver's max depth, one shot's received fields, its hidden-region mask and its rows of the
+/// measured coupling; one transfer's working memory per thread (`threads` transfers at once, one
+/// with the paper's shadow fractions) and each thread's quadrature caches at their bound; the
+/// tessellation's polygons and octree; and each distinct texture image once.
 CostEstimate scene_cost(const Scene& scene, const SolverOptions& options, int threads);
 
 /// Physical memory of the machine in bytes (0 when the system does not say).

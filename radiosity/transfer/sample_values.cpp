@@ -70,6 +70,15 @@ double IncrementIntegrator::visible_form_factor(const SurfacePoint& p) {
     return std::max(F, 0.0);
 }
 
+double cached_points_bytes() {
+    // Tensor points: the pool at its bound, and a map entry (about 64 bytes with its bucket)
+    // per cell of at least 2 x 2 points. Horizon pieces: their points, and an entry (about 96
+    // bytes with its vector) per piece, each counted as at least one point.
+    const double point = sizeof(ShooterPoint);
+    return double(max_cached_points) * (point + 64.0 / 4) +
+           double(max_cached_horizon_points) * (point + 96);
+}
+
 IncrementIntegrator::PointSpan IncrementIntegrator::points(const QuadCell& cell, int n) {
     // Key: level (5 bits), i and j (28 bits each: cells of [0,1]^2 have non-negative indices
     // below 2^level), and which of the two rules.
@@ -77,14 +86,16 @@ IncrementIntegrator::PointSpan IncrementIntegrator::points(const QuadCell& cell,
                               (std::uint64_t(cell.j) << 1) | std::uint64_t(n == options_.n ? 0 : 1);
     auto it = cache_.find(key);
     if (it != cache_.end()) return {pool_.data() + it->second, n * n};
-    // Bound the cache (deep singular corners can make many cells): at most max_cached_points
-    // (72 MB); then it starts over. Values never depend on it. The pool grows as needed, so a
-    // transfer that needs few points costs little memory (a span is used before the next call).
-    constexpr size_t max_cached_points = size_t(1) << 20;
+    // Bound the cache (deep singular corners can make many cells): at most max_cached_points;
+    // then it starts over. Values never depend on it. The pool grows as needed, so a transfer
+    // that needs few points costs little memory (a span is used before the next call), and by
+    // doubling up to the bound, never past it (cached_points_bytes counts the bound).
     if (pool_.size() + size_t(n) * n > max_cached_points) {
         cache_.clear();
         pool_.clear();
     }
+    if (pool_.size() + size_t(n) * n > pool_.capacity())
+        pool_.reserve(std::min(max_cached_points, std::max<size_t>(1024, 2 * pool_.capacity())));
     const GaussLegendre& rule = rules_[n];
     const Rect& r = cell.rect;
     const double hx = 0.5 * r.width(), hy = 0.5 * r.height();
@@ -347,8 +358,10 @@ IncrementIntegrator::PointSpan IncrementIntegrator::horizon_points(const QuadCel
     const std::uint64_t key = (cell_key(cell) << 1) | std::uint64_t(n == options_.n ? 0 : 1);
     auto it = horizon_cache_.find(key);
     if (it == horizon_cache_.end()) {
-        if (horizon_cache_.size() > 200000)
+        if (horizon_points_ > max_cached_horizon_points) {
             horizon_cache_.clear();  // bound it; values never depend on it
+            horizon_points_ = 0;
+        }
         std::vector<ShooterPoint> pts;
         ConvexPolygon piece = clip(image, view_.front);
         // A horizon through a corner of the cell leaves a near-repeated vertex where rounding
@@ -373,6 +386,8 @@ IncrementIntegrator::PointSpan IncrementIntegrator::horizon_points(const QuadCel
                 pts.push_back({plane_.to_space(X), plane_.normal, w * B, w});
             }
         }
+        horizon_points_ += pts.size() + 1;  // an empty piece's entry counts as one
+        pts.shrink_to_fit();
         it = horizon_cache_.emplace(key, std::move(pts)).first;
     }
     extra_evaluations_ += long(it->second.size()) - long(n) * n;  // the rule counts n^2 per cell

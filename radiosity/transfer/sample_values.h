@@ -5,6 +5,7 @@
 #pragma once
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <optional>
 #include <unordered_map>
@@ -86,6 +87,15 @@ struct ShooterPoint {
     double a = 0;  // w_a w_b J A_h(u,v): e without B_h (for the singularity subtraction)
 };
 
+/// Bounds of an integrator's caches of shooter points (tensor cells, and pieces only the
+/// horizon cuts), beyond which each starts over: values never depend on them. DESIGN: 2^17
+/// and 2^16 points (10 and 5 MiB); 2^20 made the room peak at 195 MiB, 126 MiB of it these
+/// caches (docs/method.md, "Memory and threads").
+constexpr size_t max_cached_points = size_t(1) << 17;
+constexpr size_t max_cached_horizon_points = size_t(1) << 16;
+/// The most one integrator's caches hold, in bytes (the memory estimate counts it per thread).
+double cached_points_bytes();
+
 /// A triangle of the shadowed part of a shooter (shadow subtraction): fan triangle `fan` of the
 /// shadow region `region`, and three points in its barycentric coordinates (weights of its
 /// second and third corners), `level` halvings deep.
@@ -152,6 +162,8 @@ public:
     /// whether (and what) it subtracted: the same constant is subtracted here.
     Rgb integrate_on(const SurfacePoint& p, const std::vector<AcceptedCell<Rgb>>& partition,
                      long* n_evaluations, long* n_rays = nullptr, const Result* made_by = nullptr);
+    /// Points the tensor cache has room for now (at most max_cached_points).
+    size_t cached_point_capacity() const { return pool_.capacity(); }
     /// The points of a cell for the n-point rule (cached): n*n points from `first`, valid until
     /// the next call.
     struct PointSpan {
@@ -218,6 +230,7 @@ private:
     std::optional<Plane> receiver_plane_;  // set_receiver_plane
     /// The front pieces' points of cells only the (fixed) horizon cuts, per cell and rule.
     std::unordered_map<std::uint64_t, std::vector<ShooterPoint>> horizon_cache_;
+    size_t horizon_points_ = 0;  // points in horizon_cache_ (each entry counts at least one)
     PointSpan horizon_points(const QuadCell& cell, int n, const ConvexPolygon& image);
     std::vector<GaussLegendre> rules_;  // rules_[n]
     std::vector<ShooterPoint> pool_;    // every cached cell's points, one after the other
