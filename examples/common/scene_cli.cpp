@@ -115,7 +115,9 @@ void finish_scene_run(const SolverArgs& a, SceneRun& run) {
     const int d = o.receiver.max_depth;
     run.cost = scene_cost(run.scene, o, thread_count());
     run.memory_budget = a.memory_budget;
-    check_cost(run.cost, run.memory_budget, describe_run(run), d >= slow_receiver_depth);
+    // DESIGN: slow means a receiver depth that holds big grids, or a minute of one core.
+    check_cost(run.cost, run.memory_budget, describe_run(run),
+               d >= slow_receiver_depth || run.cost.seconds > 60);
     // A light a hair's breadth from a surface is taken as lying on it: say so, once.
     const std::vector<NearContact> near = near_contacts(run.scene);
     if (!near.empty()) {
@@ -178,22 +180,29 @@ SceneRun read_scene_run(Args& args, Scene scene, const std::string& name) {
 
 namespace {
 
-/// A one-line progress bar on stderr, redrawn in place.
+/// Progress on stderr: on a terminal a line redrawn in place, elsewhere (a pipe, a log file) a
+/// line every `interval` seconds, the first after that long, so that short runs stay silent.
 class ProgressBar {
 public:
-    explicit ProgressBar(bool on) : on_(on && isatty(2)) {}
+    explicit ProgressBar(bool on) : on_(on), terminal_(isatty(2)), start_(now_seconds()) {}
     ~ProgressBar() {
         if (drawn_) std::fprintf(stderr, "\r%*s\r", 100, "");
     }
+    /// The hidden regions before the first shot: `done` of `total` surfaces.
+    void setup(int done, int total) {
+        const double elapsed = now_seconds() - start_;
+        const double rest = done > 0 ? elapsed * (total - done) / done : 0;
+        char line[160];
+        std::snprintf(line, sizeof line,
+                      "hidden regions: %d/%d surfaces, %.1f s, about %.0f s left", done, total,
+                      elapsed, rest);
+        show(line, done == total);
+    }
     void update(const ShotStats& shot, const ProgressiveSolver& solver, int max_shots,
                 double target) {
-        if (!on_) return;
         const SolveStats& st = solver.solution().stats;
-        const double elapsed = st.per_shot.empty() ? 0 : [&] {
-            double s = 0;
-            for (const ShotStats& x : st.per_shot) s += x.seconds;
-            return s;
-        }();
+        double elapsed = 0;
+        for (const ShotStats& x : st.per_shot) elapsed += x.seconds;
         const double left = st.emitted_power > 0 ? shot.unshot_after / st.emitted_power : 0;
         // Estimate of the rest: the unshot power has fallen from 1 to `left` in `elapsed`;
         // assume it keeps falling geometrically to the target (or the shot limit).
@@ -206,15 +215,35 @@ public:
         const int filled = static_cast<int>(done * width);
         std::string bar(filled, '#');
         bar += std::string(width - filled, '.');
-        std::fprintf(stderr, "\r[%s] shot %d/%d, unshot %.3g%%, %.1f s, about %.0f s left   ",
-                     bar.c_str(), shot.shot, max_shots, 100 * left, elapsed, rest);
-        std::fflush(stderr);
-        drawn_ = true;
+        char line[200];
+        std::snprintf(line, sizeof line, "[%s] shot %d/%d, unshot %.3g%%, %.1f s, about %.0f s left",
+                      bar.c_str(), shot.shot, max_shots, 100 * left, elapsed, rest);
+        show(line, false);
     }
 
 private:
+    static constexpr double interval = 5;  // seconds between lines off a terminal
+    void show(const char* line, bool last) {
+        if (!on_) return;
+        if (terminal_) {
+            std::fprintf(stderr, "\r%s   ", line);
+            drawn_ = true;
+        } else {
+            // Off a terminal: every `interval` seconds, and the end of a stage that was shown.
+            const double t = now_seconds() - start_;
+            if (t < next_ && !(last && shown_)) return;
+            std::fprintf(stderr, "%s\n", line);
+            shown_ = true;
+            next_ = t + interval;
+        }
+        std::fflush(stderr);
+    }
     bool on_ = false;
-    bool drawn_ = false;
+    bool terminal_ = false;
+    bool drawn_ = false;  // a line is on the terminal, to be cleared at the end
+    bool shown_ = false;  // off a terminal, some line has been printed
+    double start_ = 0;
+    double next_ = interval;
 };
 
 }  // namespace
@@ -224,10 +253,12 @@ Solution solve_scene(SceneRun& run, bool progress) {
     // picture after it (radiosity/solver/resolution.h).
     check_resolution(run.scene, run.options.receiver.max_depth);
     ProgressBar bar(progress && !run.quiet);
-    return solve(run.scene, *run.octree, run.options,
-                 [&](const ShotStats& shot, const ProgressiveSolver& solver) {
-                     bar.update(shot, solver, run.options.max_shots, run.options.convergence);
-                 });
+    return solve(
+        run.scene, *run.octree, run.options,
+        [&](const ShotStats& shot, const ProgressiveSolver& solver) {
+            bar.update(shot, solver, run.options.max_shots, run.options.convergence);
+        },
+        [&](int done, int total) { bar.setup(done, total); });
 }
 
 namespace {

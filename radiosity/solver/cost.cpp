@@ -29,6 +29,10 @@ constexpr double bytes_per_sample = sizeof(Rgb);
 // Calibration of the time: the same runs took 3.7 s at d = 7 and 12.8 s at d = 8 of wall time on
 // two busy cores, ~2e-4 s a leaf. A rough figure for a warning, nothing more.
 constexpr double seconds_per_leaf = 2e-4;
+// The hidden regions before the first shot (find_hidden, 64^2 texels of 4 to 16 rays), CPU
+// seconds a surface: 0.68 s for the room's 27 surfaces (25 ms), 7.2 s for 505 tiles of
+// scene_scaling (14 ms), user time of `mbr probe SCENE --max-shots 0`.
+constexpr double hidden_seconds_per_surface = 0.025;
 
 // Calibration of the polygons (octree_stats examples/scenes/room.scene --tessellation T
 // --rays 1000, peak resident size): 6,984 KB at T = 24 (2,558 polygons), 65,540 KB at T = 128
@@ -119,7 +123,8 @@ CostEstimate scene_cost(const Scene& scene, const SolverOptions& options, int th
     fields += coupling;
     CostEstimate c;
     c.bytes = program_bytes + fields + hidden + transfers + caches + polygons + textures;
-    c.seconds = seconds;
+    c.setup_seconds = options.hidden_regions ? n_surfaces * hidden_seconds_per_surface : 0.0;
+    c.seconds = c.setup_seconds + seconds;
     c.detail = "program " + format_bytes(program_bytes) + ", fields " + format_bytes(fields) +
                ", hidden regions " + format_bytes(hidden) + ", transfers " + format_bytes(transfers) + ", quadrature caches " +
                format_bytes(caches) + ", polygons " + format_bytes(polygons) + ", textures " +

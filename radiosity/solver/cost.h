@@ -15,7 +15,9 @@ namespace mbr {
 /// What a run will hold at its peak and roughly how long it takes, from its settings alone.
 struct CostEstimate {
     double bytes = 0;    // peak memory (worst case: every adaptive tree at its max depth)
-    double seconds = 0;  // rough wall time on one core (0: not estimated)
+    double seconds = 0;  // rough wall time on one core (0: not estimated); a scene's: its setup
+                         //   and one shot whose trees all reach the max depth
+    double setup_seconds = 0;  // of which the setup before the first shot (hidden regions)
     std::string detail;  // the parts of `bytes`, for a message ("fields 1.2 GiB, ...")
 };
 

@@ -283,7 +283,8 @@ RadiosityView radiosity_view(const Scene& scene, const Solution& solution) {
 // ---- The loop -----------------------------------------------------------------------------
 
 ProgressiveSolver::ProgressiveSolver(const Scene& scene, const Octree& octree,
-                                     const SolverOptions& options)
+                                     const SolverOptions& options,
+                                     const std::function<void(int done, int total)>& on_setup)
     : scene_(scene), octree_(octree), options_(options) {
     start_seconds_ = now();
     const int n = static_cast<int>(scene.surfaces.size());
@@ -310,7 +311,10 @@ ProgressiveSolver::ProgressiveSolver(const Scene& scene, const Octree& octree,
     weights_.resize(n);
     hidden_.resize(n);
     if (options.hidden_regions)
-        for (int i = 0; i < n; ++i) hidden_[i] = find_hidden(scene.surfaces[i].surface, i, octree);
+        for (int i = 0; i < n; ++i) {
+            hidden_[i] = find_hidden(scene.surfaces[i].surface, i, octree);  // parallel inside
+            if (on_setup) on_setup(i + 1, n);
+        }
     // "for each emitting surface L_i compute the projection of its emittance distribution".
     double emitted = 0;
     Rgb emitted_rgb;
@@ -719,8 +723,9 @@ Solution ProgressiveSolver::finish() {
 }
 
 Solution solve(const Scene& scene, const Octree& octree, const SolverOptions& options,
-               const std::function<void(const ShotStats&, const ProgressiveSolver&)>& on_shot) {
-    ProgressiveSolver solver(scene, octree, options);
+               const std::function<void(const ShotStats&, const ProgressiveSolver&)>& on_shot,
+               const std::function<void(int done, int total)>& on_setup) {
+    ProgressiveSolver solver(scene, octree, options, on_setup);
     while (!solver.done()) {
         const ShotStats shot = solver.shoot();
         if (on_shot) on_shot(shot, solver);

@@ -143,7 +143,10 @@ class ProgressiveSolver {
 public:
     /// Projects the emission; the scene and octree must outlive the solver. The octree is the
     /// one shadow rays use (build_octree(scene)).
-    ProgressiveSolver(const Scene& scene, const Octree& octree, const SolverOptions& options);
+    /// on_setup (may be empty) is called after each surface's hidden regions are found, with
+    /// the surfaces done and their total (the setup before the first shot, for progress).
+    ProgressiveSolver(const Scene& scene, const Octree& octree, const SolverOptions& options,
+                      const std::function<void(int done, int total)>& on_setup = {});
     /// True when the convergence test or the shot limit says stop.
     bool done() const;
     /// One shot: from the surface with the largest unshot power to every surface that can
@@ -208,8 +211,10 @@ private:
 };
 
 /// Solves the scene: shots until done(), calling on_shot (may be empty) after each.
+/// on_setup is passed to the solver (progress of the hidden regions).
 Solution solve(const Scene& scene, const Octree& octree, const SolverOptions& options,
-               const std::function<void(const ShotStats&, const ProgressiveSolver&)>& on_shot = {});
+               const std::function<void(const ShotStats&, const ProgressiveSolver&)>& on_shot = {},
+               const std::function<void(int done, int total)>& on_setup = {});
 
 /// The projection of a surface's emission: constant coefficients for a constant texture, else
 /// the L2 projection at `level` (Gauss-Legendre quadrature of the texture against the basis,
