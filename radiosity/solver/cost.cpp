@@ -37,8 +37,11 @@ constexpr double hidden_seconds_per_surface = 0.025;
 // Calibration of the polygons (octree_stats examples/scenes/room.scene --tessellation T
 // --rays 1000, peak resident size): 6,984 KB at T = 24 (2,558 polygons), 65,540 KB at T = 128
 // (66,830), 249,152 KB at T = 256 (264,718): about 930-945 bytes a polygon, counting the
-// facets, the polygons with their planes, and the octree's references and nodes.
-constexpr double bytes_per_polygon = 960;
+// facets, the polygons with their planes, and the octree's references and nodes. A whole
+// solve holds more a polygon: a unit sphere at T = 1024 (1,048,576 polygons) under a lamp,
+// `mbr probe`, peaked at 1,184,952 KB, about 1,100 bytes a polygon beyond the rest of the
+// estimate.
+constexpr double bytes_per_polygon = 1200;
 
 // The program before any scene: 6,488 KB resident (single_transfer --depth 0 above), 6.2-6.9 MB
 // for mbr probe of a small scene.
