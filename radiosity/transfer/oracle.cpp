@@ -100,22 +100,25 @@ bool interpolation_agrees(const Oracle& o, const Rect& r, int thread, long* eval
 
 }  // namespace
 
+double distance_to_outline(const ConvexPolygon& outline, Vec2 q) {
+    double best = std::numeric_limits<double>::infinity();
+    const size_t n = outline.size();
+    for (size_t k = 0; k < n; ++k) {
+        const Vec2 a = outline[k], b = outline[(k + 1) % n];
+        const Vec2 e = b - a;
+        const double len2 = dot(e, e);
+        const double t = len2 > 0 ? std::clamp(dot(q - a, e) / len2, 0.0, 1.0) : 0.0;
+        const Vec2 d = q - (a + t * e);
+        best = std::min(best, std::sqrt(dot(d, d)));
+    }
+    return best;
+}
+
 double distance_to_shooter(const ShooterPlane& plane, Vec3 x) {
     const double height = dot(x - plane.origin, plane.normal);
     const Vec2 q = plane.to_plane(x);
     double across = 0;
-    if (!contains(plane.outline, q)) {
-        across = std::numeric_limits<double>::infinity();
-        const size_t n = plane.outline.size();
-        for (size_t k = 0; k < n; ++k) {
-            const Vec2 a = plane.outline[k], b = plane.outline[(k + 1) % n];
-            const Vec2 e = b - a;
-            const double len2 = dot(e, e);
-            const double t = len2 > 0 ? std::clamp(dot(q - a, e) / len2, 0.0, 1.0) : 0.0;
-            const Vec2 d = q - (a + t * e);
-            across = std::min(across, std::sqrt(dot(d, d)));
-        }
-    }
+    if (!contains(plane.outline, q)) across = distance_to_outline(plane.outline, q);
     return std::sqrt(height * height + across * across);
 }
 
@@ -152,19 +155,10 @@ bool hovers_at_outline(const Surface& receiver, const ShooterPlane& plane, const
         for (double s : {r.x0, 0.5 * (r.x0 + r.x1), r.x1})
             p[k++] = receiver.evaluate(s, t).position;
     const double size = std::max(length(p[8] - p[0]), length(p[6] - p[2]));
-    const size_t n = plane.outline.size();
     for (const Vec3& x : p) {
         const double height = dot(x - plane.origin, plane.normal);
         if (height < 0 || height > 0.5 * size) continue;
-        const Vec2 q = plane.to_plane(x);
-        for (size_t e = 0; e < n; ++e) {
-            const Vec2 a = plane.outline[e], b = plane.outline[(e + 1) % n];
-            const Vec2 d = b - a;
-            const double len2 = dot(d, d);
-            const double t = len2 > 0 ? std::clamp(dot(q - a, d) / len2, 0.0, 1.0) : 0.0;
-            const Vec2 off = q - (a + t * d);
-            if (dot(off, off) <= 0.25 * size * size) return true;
-        }
+        if (distance_to_outline(plane.outline, plane.to_plane(x)) <= 0.5 * size) return true;
     }
     return false;
 }

@@ -14,6 +14,9 @@ namespace mbr {
 /// max_depth bound the tree.
 void subdivide_by_oracle(ReceiverState& state, IncrementSampler& sampler);
 
+/// Distance from q to the boundary (the edges) of a polygon in its plane.
+double distance_to_outline(const ConvexPolygon& outline, Vec2 q);
+
 /// Distance from x to a planar shooter's closed polygon (its frame and outline): the contact
 /// rule's measure (and the resolution check's, radiosity/solver/resolution.h).
 double distance_to_shooter(const ShooterPlane& plane, Vec3 x);
