@@ -1,9 +1,8 @@
 // test/test_limiter.cpp - the limiter's two clips (radiosity/solver/limiter.h): an increment's
 // overshoot clipped to its bound, and a field lifted to zero where it rings below it, each
 // changing the field only where it leaves its bounds.
-#include <catch2/catch.hpp>
-
 #include <algorithm>
+#include <catch2/catch.hpp>
 #include <cmath>
 #include <vector>
 
@@ -29,14 +28,14 @@ SplineField projected_step(double high, double low) {
 std::vector<double> grid_values(const SplineField& f, int c, int n) {
     std::vector<double> out;
     for (int a = 0; a < n; ++a)
-        for (int b = 0; b < n; ++b) out.push_back(f.evaluate(double(a) / (n - 1), double(b) / (n - 1))[c]);
+        for (int b = 0; b < n; ++b)
+            out.push_back(f.evaluate(double(a) / (n - 1), double(b) / (n - 1))[c]);
     return out;
 }
 
 }  // namespace
 
-TEST_CASE("limiter: limit_positive lifts a ringing step to zero and only raises it",
-          "[limiter]") {
+TEST_CASE("limiter: limit_positive lifts a ringing step to zero and only raises it", "[limiter]") {
     const SplineField before = projected_step(1.0, 0.0);
     SplineField after = before;
     limit_positive(after);

@@ -5,9 +5,8 @@
 // on some face), the single transfer of radiosity/transfer/transfer.h run by hand with the options
 // the loop gives it, and the analytic point-to-polygon form factor for a first bounce. The scenes
 // are small and the depths low, so that every test runs in about a second.
-#include <catch2/catch.hpp>
-
 #include <array>
+#include <catch2/catch.hpp>
 #include <cmath>
 #include <sstream>
 #include <string>
@@ -515,8 +514,8 @@ TEST_CASE("solver: with the limiter, a light a hair above the floor stays within
                 hi = std::max(hi, v);
             }
         const double centre = view.at(floor, 0.5, 0.5)[0];
-        test::report() << "limiter " << limiter << ": floor in [" << lo << ", " << hi
-                       << "], " << centre << " under the light's centre\n";
+        test::report() << "limiter " << limiter << ": floor in [" << lo << ", " << hi << "], "
+                       << centre << " under the light's centre\n";
         return std::array<double, 3>{lo, hi, centre};
     };
     const auto limited = extremes(true);

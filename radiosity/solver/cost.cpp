@@ -117,10 +117,9 @@ CostEstimate scene_cost(const Scene& scene, const SolverOptions& options, int th
     const double caches = double(std::max(1, threads)) * cached_points_bytes();
     // Per surface: its hidden-region mask (a byte and a substitute point per texel), and a row
     // of the measured coupling for every shooter that has shot (at most max_shots rows).
-    const double hidden =
-        options.hidden_regions
-            ? n_surfaces * hidden_resolution * hidden_resolution * (1.0 + sizeof(Vec2))
-            : 0.0;
+    const double hidden = options.hidden_regions ? n_surfaces * hidden_resolution *
+                                                       hidden_resolution * (1.0 + sizeof(Vec2))
+                                                 : 0.0;
     const double coupling =
         std::min(double(std::max(0, options.max_shots)), n_surfaces) * n_surfaces * sizeof(Rgb);
     fields += coupling;
@@ -129,9 +128,9 @@ CostEstimate scene_cost(const Scene& scene, const SolverOptions& options, int th
     c.setup_seconds = options.hidden_regions ? n_surfaces * hidden_seconds_per_surface : 0.0;
     c.seconds = c.setup_seconds + seconds;
     c.detail = "program " + format_bytes(program_bytes) + ", fields " + format_bytes(fields) +
-               ", hidden regions " + format_bytes(hidden) + ", transfers " + format_bytes(transfers) + ", quadrature caches " +
-               format_bytes(caches) + ", polygons " + format_bytes(polygons) + ", textures " +
-               format_bytes(textures);
+               ", hidden regions " + format_bytes(hidden) + ", transfers " +
+               format_bytes(transfers) + ", quadrature caches " + format_bytes(caches) +
+               ", polygons " + format_bytes(polygons) + ", textures " + format_bytes(textures);
     return c;
 }
 
