@@ -124,16 +124,22 @@ double distance_to_shooter(const ShooterPlane& plane, Vec3 x) {
 
 namespace {
 
+/// The corners, edge midpoints and centre of a receiver cell in space (row by row from
+/// (x0, y0)), and the cell's size: the longer of its diagonals.
+double cell_points(const Surface& receiver, const Rect& r, Vec3 p[9]) {
+    int k = 0;
+    for (double t : {r.y0, 0.5 * (r.y0 + r.y1), r.y1})
+        for (double s : {r.x0, 0.5 * (r.x0 + r.x1), r.x1})
+            p[k++] = receiver.evaluate(s, t).position;
+    return std::max(length(p[8] - p[0]), length(p[6] - p[2]));
+}
+
 /// The contact rule (beyond the paper, ReceiverOptions::contact_depth and contact_oracle_test):
 /// true when the receiver's cell comes within half its size of a planar shooter: its corners,
 /// edge midpoints and centre are tested (the contact lines of scenes are straight).
 bool touches_shooter(const Surface& receiver, const ShooterPlane& plane, const Rect& r) {
     Vec3 p[9];
-    int k = 0;
-    for (double t : {r.y0, 0.5 * (r.y0 + r.y1), r.y1})
-        for (double s : {r.x0, 0.5 * (r.x0 + r.x1), r.x1})
-            p[k++] = receiver.evaluate(s, t).position;
-    const double size = std::max(length(p[8] - p[0]), length(p[6] - p[2]));
+    const double size = cell_points(receiver, r, p);
     for (const Vec3& x : p)
         if (distance_to_shooter(plane, x) <= 0.5 * size) return true;
     return false;
@@ -150,11 +156,7 @@ bool hovers_at_outline(const Surface& receiver, const ShooterPlane& plane, const
     const SurfacePoint centre = receiver.evaluate(0.5 * (r.x0 + r.x1), 0.5 * (r.y0 + r.y1));
     if (dot(centre.normal, plane.normal) > -0.9) return false;
     Vec3 p[9];
-    int k = 0;
-    for (double t : {r.y0, 0.5 * (r.y0 + r.y1), r.y1})
-        for (double s : {r.x0, 0.5 * (r.x0 + r.x1), r.x1})
-            p[k++] = receiver.evaluate(s, t).position;
-    const double size = std::max(length(p[8] - p[0]), length(p[6] - p[2]));
+    const double size = cell_points(receiver, r, p);
     for (const Vec3& x : p) {
         const double height = dot(x - plane.origin, plane.normal);
         if (height < 0 || height > 0.5 * size) continue;
