@@ -1,5 +1,6 @@
 // octree/octree.cpp - the paper's pointer octree (section 6, "Octree"): the three-step
-// node-polygon test that builds it, and front-to-back ray traversal for the queries.
+// node-polygon test that builds it, its flat layout (octree.h), and front-to-back ray traversal
+// for the queries, node for node the traversal of the pointer layout it replaced.
 #include "octree/octree.h"
 
 #include <algorithm>
@@ -39,38 +40,6 @@ bool segment_meets_rect(Vec2 p0, Vec2 p1, Vec2 lo, Vec2 hi) {
         u0 = std::max(u0, ua);
         u1 = std::min(u1, ub);
         if (u0 > u1) return false;
-    }
-    return true;
-}
-
-// Child i of a cube: bit 0 of i selects the upper half in x, bit 1 in y, bit 2 in z. Build and
-// traversal both split here, so their cubes are bit-identical.
-Box3 child_cube(const Box3& cube, int i) {
-    Vec3 mid = cube.centre();
-    Box3 c;
-    for (int k = 0; k < 3; ++k) {
-        bool upper = (i >> k) & 1;
-        c.lo[k] = upper ? mid[k] : cube.lo[k];
-        c.hi[k] = upper ? cube.hi[k] : mid[k];
-    }
-    return c;
-}
-
-// Slab test: narrows [t0, t1] to the part of the ray inside the box; false if nothing is left.
-// A zero direction component constrains only through the origin's position; a NaN bound (a
-// denormal component times a zero distance) constrains nothing, which errs towards visiting.
-bool clip_to_box(const Box3& box, const Ray& ray, Vec3 inv_dir, double& t0, double& t1) {
-    for (int k = 0; k < 3; ++k) {
-        if (ray.dir[k] == 0) {
-            if (ray.origin[k] < box.lo[k] || ray.origin[k] > box.hi[k]) return false;
-            continue;
-        }
-        double ta = (box.lo[k] - ray.origin[k]) * inv_dir[k];
-        double tb = (box.hi[k] - ray.origin[k]) * inv_dir[k];
-        if (ta > tb) std::swap(ta, tb);
-        if (ta > t0) t0 = ta;
-        if (tb < t1) t1 = tb;
-        if (t0 > t1) return false;
     }
     return true;
 }
@@ -192,25 +161,190 @@ RayStats& RayStats::operator+=(const RayStats& other) {
     return *this;
 }
 
-// A cube of the tree. Internal nodes own up to eight children (null where the child would meet
-// no polygon) and list nothing; leaves list the polygons that meet their (grown) cube.
-struct Octree::Node {
-    std::array<std::unique_ptr<Node>, 8> children;
-    std::vector<int> polygons;
-    bool is_leaf = true;
+// Child i of a cube: bit 0 of i selects the upper half in x, bit 1 in y, bit 2 in z. Build,
+// traversal and collect all split here, so their cubes are bit-identical.
+Box3 Octree::child_cube(const Box3& cube, int i) {
+    Vec3 mid = cube.centre();
+    Box3 c;
+    for (int k = 0; k < 3; ++k) {
+        bool upper = (i >> k) & 1;
+        c.lo[k] = upper ? mid[k] : cube.lo[k];
+        c.hi[k] = upper ? cube.hi[k] : mid[k];
+    }
+    return c;
+}
+
+// Ray records numbered as the build's leaves first list their polygons.
+struct Octree::Numbering {
+    std::vector<int> record_of;  // polygon index -> record number, -1 until listed
+    int n_records = 0;
 };
 
 // The state of one ray query, all on the caller's stack (queries are thread-safe).
 struct Octree::Query {
     Ray ray;                     // closest hit: t_max shrinks to the best hit found so far
     Vec3 inv_dir;                // 1 / dir per component (unused where dir is zero)
+    int flip = 0;                // bit k set when dir[k] < 0
+    bool finite_inv_dir = true;  // every component of inv_dir is finite
     bool any = false;            // any-hit query: stop at the first hit
     RayFilter filter;            // surfaces whose polygons are skipped
     std::array<Vec3, 2> ends;    // segment_ends(ray), when filter.ends_on_surfaces
     int best = -1;               // polygon of the best hit so far
     std::array<int, 32> recent;  // polygon tested recently, by polygon index mod 32
     RayStats stats;
+    Query(const Ray& r, const RayFilter& f, bool any_hit);
+    void slab(int k, double lo, double hi, double& entry, double& exit) const;
+    bool meets_box(const Box3& box) const;
 };
+
+// The slab test along axis k of a box with faces lo < hi: the t at which the ray enters and
+// leaves the slab. The pointer octree's slab test (clip_to_box, before the flat layout) took
+// ta = (lo - o) * inv_dir and tb = (hi - o) * inv_dir, swapped them if ta > tb, raised t0 to ta
+// and lowered t1 to tb (comparisons that pass over NaN), and answered "apart" once t0 > t1; a
+// zero dir[k] answered "apart" when the origin was outside the slab. These are its values: where
+// dir[k] is zero, (-inf, inf) if the origin lies in the slab and (inf, -inf) if not, which the
+// comparisons of meets_box and child_hits turn into its answers.
+inline void Octree::Query::slab(int k, double lo, double hi, double& entry, double& exit) const {
+    if (ray.dir[k] == 0) {
+        const bool in = !(ray.origin[k] < lo || ray.origin[k] > hi);
+        entry = in ? -HUGE_VAL : HUGE_VAL;
+        exit = in ? HUGE_VAL : -HUGE_VAL;
+        return;
+    }
+    if (finite_inv_dir) {
+        // The swap makes the near face's t the entry: rounding keeps the order of the faces'
+        // t, and with a finite 1 / dir both are NaN (a NaN origin) or neither is.
+        const bool down = (flip >> k) & 1;
+        entry = ((down ? hi : lo) - ray.origin[k]) * inv_dir[k];
+        exit = ((down ? lo : hi) - ray.origin[k]) * inv_dir[k];
+        return;
+    }
+    // 1 / dir[k] may be infinite (a denormal dir[k]) and one t NaN: the old steps as they were.
+    double ta = (lo - ray.origin[k]) * inv_dir[k];
+    double tb = (hi - ray.origin[k]) * inv_dir[k];
+    if (ta > tb) std::swap(ta, tb);
+    entry = ta;
+    exit = tb;
+}
+
+// Whether the ray meets the box with t in [t_min, t_max], as the pointer octree's slab test
+// decided (t_min <= t_max first). t0 only grows and t1 only shrinks, so testing t0 > t1 once at
+// the end decides as its test after every axis did.
+bool Octree::Query::meets_box(const Box3& box) const {
+    double t0 = ray.t_min, t1 = ray.t_max;
+    if (!(t0 <= t1)) return false;
+    for (int k = 0; k < 3; ++k) {
+        double entry, exit;
+        slab(k, box.lo[k], box.hi[k], entry, exit);
+        if (entry > t0) t0 = entry;
+        if (exit < t1) t1 = exit;
+    }
+    return !(t0 > t1);
+}
+
+Octree::Query::Query(const Ray& r, const RayFilter& f, bool any_hit)
+    : ray(r), any(any_hit), filter(f) {
+    if (filter.ends_on_surfaces) ends = segment_ends(ray);
+    recent.fill(-1);
+    for (int k = 0; k < 3; ++k) {
+        inv_dir[k] = ray.dir[k] != 0 ? 1 / ray.dir[k] : 0;
+        if (ray.dir[k] < 0) flip |= 1 << k;
+        if (!std::isfinite(inv_dir[k])) finite_inv_dir = false;
+    }
+}
+
+namespace {
+
+// The index of the lowest bit set in an 8-bit mask (8 for none), a table built at compile time.
+struct LowestBit {
+    std::array<std::uint8_t, 256> of{};
+    constexpr LowestBit() {
+        for (int m = 0; m < 256; ++m) {
+            of[m] = 8;
+            for (int b = 7; b >= 0; --b)
+                if ((m >> b) & 1) of[m] = static_cast<std::uint8_t>(b);
+        }
+    }
+};
+constexpr LowestBit lowest_bit;
+
+// The mask with bit j set where bit j ^ flip of m is: the children in the order of a ray whose
+// direction's signs are flip (see Octree::traverse).
+unsigned flip_bits(unsigned m, int flip) {
+    if (flip & 1) m = ((m & 0x55u) << 1) | ((m >> 1) & 0x55u);
+    if (flip & 2) m = ((m & 0x33u) << 2) | ((m >> 2) & 0x33u);
+    if (flip & 4) m = ((m & 0x0Fu) << 4) | ((m >> 4) & 0x0Fu);
+    return m;
+}
+
+}  // namespace
+
+// Where a ray meets the eight grown children of a node (the pointer octree's slab test of
+// grown(child_cube(cube, i)) with t in [t_min, t_max], decision for decision).
+struct Octree::ChildHits {
+    std::array<double, 8> entry;  // entry[i]: where the ray enters child i's grown cube
+    unsigned meets = 0;           // bit i: child i exists and the ray meets it
+    // The children met in the order of the pointer octree's insertion sort: by entry, equal
+    // entries in octant order. The order of the direction's signs (see Octree::traverse) nearly
+    // always is that order already; where it is not, the children are sorted. Returns how many;
+    // order[k] is the k-th octant.
+    int sorted(int flip, std::array<int, 8>& order) const {
+        auto before = [&](int a, int b) {
+            return entry[a] < entry[b] || (entry[a] == entry[b] && a < b);
+        };
+        int n = 0;
+        bool in_order = true;
+        for (unsigned m = flip_bits(meets, flip); m != 0; m &= m - 1, ++n) {
+            order[n] = lowest_bit.of[m] ^ flip;
+            if (n > 0) in_order = in_order && before(order[n - 1], order[n]);
+        }
+        if (in_order) return n;
+        for (int k = 1; k < n; ++k) {
+            const int i = order[k];
+            int j = k;
+            for (; j > 0 && before(i, order[j - 1]); --j) order[j] = order[j - 1];
+            order[j] = i;
+        }
+        return n;
+    }
+};
+
+Octree::ChildHits Octree::child_hits(const Block& block, unsigned mask, const Query& q) const {
+    // The faces of the grown children along each axis: the lower child spans [lo, mid_hi], the
+    // upper one [mid_lo, hi] (grown(child_cube(cube, i)) component by component). Six slabs
+    // serve the eight children.
+    const Box3& cube = block.cube;
+    const Vec3 m{margin_, margin_, margin_};
+    const Vec3 mid = cube.centre();
+    const Vec3 lo = cube.lo - m, mid_lo = mid - m, mid_hi = mid + m, hi = cube.hi + m;
+    double slab_entry[3][2], slab_exit[3][2];
+    for (int k = 0; k < 3; ++k) {
+        q.slab(k, lo[k], mid_hi[k], slab_entry[k][0], slab_exit[k][0]);
+        q.slab(k, mid_lo[k], hi[k], slab_entry[k][1], slab_exit[k][1]);
+    }
+    // The slab test of each child without branches, in the old order of axes (x, y, z), the
+    // children sharing the steps for x and y.
+    auto later = [](double t, double t0) { return t > t0 ? t : t0; };    // the old t0 and t1
+    auto earlier = [](double t, double t1) { return t < t1 ? t : t1; };  // updates
+    double t0_x[2], t1_x[2], t0_xy[4], t1_xy[4];
+    for (int u = 0; u < 2; ++u) {
+        t0_x[u] = later(slab_entry[0][u], q.ray.t_min);
+        t1_x[u] = earlier(slab_exit[0][u], q.ray.t_max);
+    }
+    for (int i = 0; i < 4; ++i) {
+        t0_xy[i] = later(slab_entry[1][i >> 1], t0_x[i & 1]);
+        t1_xy[i] = earlier(slab_exit[1][i >> 1], t1_x[i & 1]);
+    }
+    ChildHits h;
+    for (int i = 0; i < 8; ++i) {
+        const double t0 = later(slab_entry[2][i >> 2], t0_xy[i & 3]);
+        const double t1 = earlier(slab_exit[2][i >> 2], t1_xy[i & 3]);
+        h.entry[i] = t0;
+        h.meets |= static_cast<unsigned>(!(t0 > t1)) << i;
+    }
+    h.meets &= mask;
+    return h;
+}
 
 Octree::~Octree() = default;
 Octree::Octree(Octree&&) noexcept = default;
@@ -242,10 +376,43 @@ Octree::Octree(std::vector<Polygon> polygons, Options options)
     // and the ray enters that node strictly before the hit. (The slack region sticks out beyond a
     // vertex of angle theta by edge_slack / sin(theta / 2): covered for angles above ~1e-3 rad.)
     margin_ = 1e-7 * side + 2 * slack;
+    grown_root_ = grown(root_cube_);
 
     std::vector<int> ids(polygons_.size());
     for (int i = 0; i < static_cast<int>(ids.size()); ++i) ids[i] = i;
-    root_ = build(root_cube_, std::move(ids), 0);
+    Numbering numbering;
+    numbering.record_of.assign(polygons_.size(), -1);
+    root_ = build(root_cube_, std::move(ids), 0, numbering);
+    has_root_ = true;
+    make_records(numbering);
+}
+
+// The ray records in the order of `numbering` (a polygon no leaf lists, which the node test
+// never allows, would get one at the end), and the leaves' lists turned from polygon indices
+// into record numbers.
+void Octree::make_records(Numbering& numbering) {
+    std::vector<int>& record_of = numbering.record_of;
+    for (int& r : record_of)
+        if (r < 0) r = numbering.n_records++;
+    records_.resize(polygons_.size());
+    record_polygon_.resize(polygons_.size());
+    for (int id = 0; id < polygon_count(); ++id) {
+        const Polygon& p = polygons_[id];
+        RayRecord& r = records_[record_of[id]];
+        r.plane = p.plane();
+        r.slack = p.edge_slack();
+        r.polygon = id;
+        r.surface = p.surface();
+        r.n_planes = p.n_vertices();
+        r.first_extra = static_cast<int>(extra_planes_.size());
+        const std::vector<Plane>& b = p.bounding_planes();
+        if (r.n_planes <= 4)
+            std::copy(b.begin(), b.end(), r.planes.begin());
+        else
+            extra_planes_.insert(extra_planes_.end(), b.begin(), b.end());
+        record_polygon_[record_of[id]] = id;
+    }
+    for (int& entry : leaf_records_) entry = record_of[entry];
 }
 
 Box3 Octree::grown(const Box3& cube) const {
@@ -253,8 +420,11 @@ Box3 Octree::grown(const Box3& cube) const {
     return Box3{cube.lo - m, cube.hi + m};
 }
 
-std::unique_ptr<Octree::Node> Octree::build(const Box3& cube, std::vector<int> ids, int depth) {
-    auto node = std::make_unique<Node>();
+// Builds the node of `cube` listing `ids` and its subtree. An internal node's block is appended
+// before its children's (depth first). A leaf's list holds polygon indices until make_records;
+// `numbering` numbers the polygons as leaves first list them.
+Octree::Node Octree::build(const Box3& cube, std::vector<int> ids, int depth,
+                           Numbering& numbering) {
     ++node_count_;
     depth_ = std::max(depth_, depth);
     const int n_ids = static_cast<int>(ids.size());
@@ -275,73 +445,87 @@ std::unique_ptr<Octree::Node> Octree::build(const Box3& cube, std::vector<int> i
         // max_polygons_per_leaf polygons overlap (coplanar copies, dense coplanar layers) would
         // be split down to max_depth: 4^depth nodes holding the same lists.
         if (0.25 * static_cast<double>(n_child_refs) + 1 < n_ids) {
-            node->is_leaf = false;
-            for (int i = 0; i < 8; ++i)
-                if (!lists[i].empty())
-                    node->children[i] = build(child_cube(cube, i), std::move(lists[i]), depth + 1);
-            return node;
+            const int b = static_cast<int>(blocks_.size());
+            blocks_.emplace_back();
+            blocks_[b].cube = cube;
+            unsigned mask = 0;
+            for (int i = 0; i < 8; ++i) {
+                if (lists[i].empty()) continue;
+                mask |= 1u << i;
+                const Node child =
+                    build(child_cube(cube, i), std::move(lists[i]), depth + 1, numbering);
+                blocks_[b].child[i] = child;  // blocks_ may have grown: index again
+            }
+            return Node::internal(b, mask);
         }
     }
     ++leaf_count_;
     reference_count_ += n_ids;
-    node->polygons = std::move(ids);
-    return node;
+    const Node leaf = Node::leaf(static_cast<int>(leaf_records_.size()), n_ids);
+    leaf_records_.insert(leaf_records_.end(), ids.begin(), ids.end());
+    for (int id : ids)
+        if (numbering.record_of[id] < 0) numbering.record_of[id] = numbering.n_records++;
+    return leaf;
 }
 
-bool Octree::traverse(const Node& node, const Box3& cube, Query& q) const {
-    ++q.stats.n_nodes_visited;
-    if (node.is_leaf) {
-        for (int id : node.polygons) {
-            // A polygon listed by several leaves is tested once per ray unless another polygon
-            // with the same index mod 32 was tested in between; a repeated test is only wasted
-            // work. Skipping is sound: t_max only shrinks, so an earlier miss stays a miss and an
-            // earlier hit is already recorded.
-            int& slot = q.recent[id & 31];
-            if (slot == id) continue;
-            slot = id;
-            if (q.filter.skips(polygons_[id].surface())) continue;
-            ++q.stats.n_polygons_tested;
-            std::optional<double> t = polygons_[id].intersect(q.ray);
-            if (!t) continue;
-            // The same polygon keeps the same answer for the same ends, so skipping repeated
-            // tests stays sound.
-            if (q.filter.ends_on_surfaces && !polygons_[id].hit_counts(q.ends[0], q.ends[1]))
-                continue;
-            if (q.any) {
-                q.best = id;
-                return true;
-            }
-            // intersect() accepts t <= t_max, so equal-t hits arrive here: keep the lowest index.
-            if (*t < q.ray.t_max || q.best < 0 || id < q.best) {
-                q.ray.t_max = *t;
-                q.best = id;
-            }
+bool Octree::test_leaf(const Node& node, Query& q) const {
+    for (int r = node.first, end = node.first + node.count(); r < end; ++r) {
+        const RayRecord& p = records_[leaf_records_[r]];
+        const int id = p.polygon;
+        // A polygon listed by several leaves is tested once per ray unless another polygon
+        // with the same index mod 32 was tested in between; a repeated test is only wasted
+        // work. Skipping is sound: t_max only shrinks, so an earlier miss stays a miss and an
+        // earlier hit is already recorded.
+        int& slot = q.recent[id & 31];
+        if (slot == id) continue;
+        slot = id;
+        if (q.filter.skips(p.surface)) continue;
+        ++q.stats.n_polygons_tested;
+        // Polygon::intersect's own function on the packed copy of its planes: the same t.
+        std::optional<double> t =
+            intersect_planes(p.plane, p.bounding(extra_planes_), p.n_planes, p.slack, q.ray);
+        if (!t) continue;
+        // The same polygon keeps the same answer for the same ends, so skipping repeated
+        // tests stays sound.
+        if (q.filter.ends_on_surfaces && !polygons_[id].hit_counts(q.ends[0], q.ends[1])) continue;
+        if (q.any) {
+            q.best = id;
+            return true;
         }
+        // intersect() accepts t <= t_max, so equal-t hits arrive here: keep the lowest index.
+        if (*t < q.ray.t_max || q.best < 0 || id < q.best) {
+            q.ray.t_max = *t;
+            q.best = id;
+        }
+    }
+    return false;
+}
+
+// Visits a node and, front to back, the children the ray meets. True when an any-hit query is
+// answered.
+bool Octree::traverse(const Node& node, Query& q) const {
+    ++q.stats.n_nodes_visited;
+    if (node.is_leaf()) return test_leaf(node, q);
+    const Block& block = blocks_[node.first];
+    const ChildHits hits = child_hits(block, node.child_mask(), q);
+    if (q.any) {
+        // Any hit: t_max stays put, so every child met is visited unless a hit ends the query,
+        // and the answer does not depend on the order. The direction's signs give one no ray
+        // contradicts: with bit k of flip set where dir[k] < 0, child j ^ flip for j = 0..7 (a
+        // ray crosses from child a into child b only where b's bits differ from a's towards the
+        // signs). No sort.
+        for (unsigned order = flip_bits(hits.meets, q.flip); order != 0; order &= order - 1)
+            if (traverse(block.child[lowest_bit.of[order] ^ q.flip], q)) return true;
         return false;
     }
-    // Front to back: children ordered by the t at which the ray enters their grown cubes. The
-    // cubes are disjoint but for the margin, so this is the order along the ray.
-    struct Entry {
-        double t;
-        int child;
-    };
-    std::array<Entry, 8> order;
-    int n_order = 0;
-    std::array<Box3, 8> cubes;
-    for (int i = 0; i < 8; ++i) {
-        if (!node.children[i]) continue;
-        cubes[i] = child_cube(cube, i);
-        double t0 = q.ray.t_min, t1 = q.ray.t_max;
-        if (!clip_to_box(grown(cubes[i]), q.ray, q.inv_dir, t0, t1)) continue;
-        int j = n_order++;
-        for (; j > 0 && order[j - 1].t > t0; --j) order[j] = order[j - 1];
-        order[j] = {t0, i};
-    }
-    for (int k = 0; k < n_order; ++k) {
-        // Early exit: this child and all after it start beyond the best hit so far.
-        if (order[k].t > q.ray.t_max) break;
-        int i = order[k].child;
-        if (traverse(*node.children[i], cubes[i], q)) return true;
+    // Closest hit: by the t at which the ray enters the children's grown cubes (disjoint but for
+    // the margin, so this is the order along the ray), stopping at the first that starts beyond
+    // the best hit so far. The children, their order and the stop are the pointer octree's own,
+    // so the query tests the same polygons in the same order as before the flat layout.
+    std::array<int, 8> order;
+    for (int k = 0, n = hits.sorted(q.flip, order); k < n; ++k) {
+        if (hits.entry[order[k]] > q.ray.t_max) break;
+        traverse(block.child[order[k]], q);
     }
     return false;
 }
@@ -352,16 +536,9 @@ std::optional<Hit> Octree::closest_hit(const Ray& ray, RayStats* stats) const {
 
 std::optional<Hit> Octree::closest_hit(const Ray& ray, const RayFilter& filter,
                                        RayStats* stats) const {
-    if (!root_) return std::nullopt;
-    Query q;
-    q.ray = ray;
-    q.filter = filter;
-    if (filter.ends_on_surfaces) q.ends = segment_ends(ray);
-    q.recent.fill(-1);
-    for (int k = 0; k < 3; ++k) q.inv_dir[k] = ray.dir[k] != 0 ? 1 / ray.dir[k] : 0;
-    double t0 = ray.t_min, t1 = ray.t_max;
-    if (t0 <= t1 && clip_to_box(grown(root_cube_), ray, q.inv_dir, t0, t1))
-        traverse(*root_, root_cube_, q);
+    if (!has_root_) return std::nullopt;
+    Query q(ray, filter, false);
+    if (q.meets_box(grown_root_)) traverse(root_, q);
     if (stats) *stats += q.stats;
     if (q.best < 0) return std::nullopt;
     const Polygon& p = polygons_[q.best];
@@ -374,24 +551,11 @@ bool Octree::any_hit(const Ray& ray, RayStats* stats) const {
 }
 
 bool Octree::any_hit(const Ray& ray, const RayFilter& filter, RayStats* stats) const {
-    if (!root_) return false;
-    Query q;
-    q.ray = ray;
-    q.any = true;
-    q.filter = filter;
-    if (filter.ends_on_surfaces) q.ends = segment_ends(ray);
-    q.recent.fill(-1);
-    for (int k = 0; k < 3; ++k) q.inv_dir[k] = ray.dir[k] != 0 ? 1 / ray.dir[k] : 0;
-    double t0 = ray.t_min, t1 = ray.t_max;
-    bool hit = t0 <= t1 && clip_to_box(grown(root_cube_), ray, q.inv_dir, t0, t1) &&
-               traverse(*root_, root_cube_, q);
+    if (!has_root_) return false;
+    Query q(ray, filter, true);
+    const bool hit = q.meets_box(grown_root_) && traverse(root_, q);
     if (stats) *stats += q.stats;
     return hit;
 }
-
-bool Octree::node_is_leaf(const Node& node) { return node.is_leaf; }
-const std::vector<int>& Octree::node_polygons(const Node& node) { return node.polygons; }
-const Octree::Node* Octree::node_child(const Node& node, int i) { return node.children[i].get(); }
-Box3 Octree::node_child_cube(const Box3& cube, int i) { return child_cube(cube, i); }
 
 }  // namespace mbr

@@ -14,10 +14,22 @@
 // is apart: step 2). The tests find no over-report against exact clipping, including polygons
 // placed in a plane through the cube right next to its cross-section, where step 3 alone errs.
 // Only the tolerances that steer rounding towards "meet" (1e-12 of the coordinates) remain.
+//
+// Layout (beyond the paper, for the cache; the tree, its subdivision and every query's path
+// through it are those of the pointer octree it replaced). A node is 8 bytes: a leaf holds where
+// its list starts and its length, an internal node the index of its block and which octants have
+// a child. A block holds an internal node's cube and its eight child nodes (the pointers of the
+// paper's octree become indices), 128 bytes aligned on two cache lines; the blocks lie in one
+// array in depth-first order. Cubes are stored, not recomputed: a visit reads its node's block
+// and works out the six slabs of the children's grown cubes once. The leaves' lists are slices of
+// one array of "ray records": what the ray-polygon test reads of a polygon (its plane, bounding
+// planes, slack, surface and index) in three cache lines, numbered in the order the leaves first
+// list them, so a leaf's records lie close together. Queries keep their state on the stack.
 #pragma once
 
 #include <algorithm>
-#include <memory>
+#include <array>
+#include <cstdint>
 #include <optional>
 #include <ostream>
 #include <vector>
@@ -94,7 +106,8 @@ struct OctreeOptions {
     int max_polygons_per_leaf = 8;  // a node listing more is split (below max_depth, if it pays)
 };
 
-/// The paper's pointer octree over a set of polygons. Immutable after construction; its queries
+/// The paper's pointer octree over a set of polygons (its pointers are indices: see the file
+/// comment). Immutable after construction; its queries
 /// keep all state on the stack, so any number of threads may query one octree at once.
 class Octree {
 public:
@@ -119,8 +132,9 @@ public:
     /// The same, skipping the polygons and hits `filter` names.
     std::optional<Hit> closest_hit(const Ray& ray, const RayFilter& filter,
                                    RayStats* stats = nullptr) const;
-    /// Whether any polygon is hit with t in [ray.t_min, ray.t_max] (shadow rays). Stops at the
-    /// first hit found. Adds its work to *stats if given.
+    /// Whether any polygon is hit with t in [ray.t_min, ray.t_max] (shadow rays). Visits nodes in
+    /// the order of the direction's signs (no sort) and stops at the first hit found. Adds its
+    /// work to *stats if given.
     bool any_hit(const Ray& ray, RayStats* stats = nullptr) const;
     /// The same, skipping the polygons and hits `filter` names.
     bool any_hit(const Ray& ray, const RayFilter& filter, RayStats* stats = nullptr) const;
@@ -139,7 +153,7 @@ public:
     /// accepted leaves once for each (for callers that filter first and sort what is left).
     template <class NodeTest>
     void append_polygons_near(NodeTest&& node_may_meet, std::vector<int>& out) const {
-        if (root_) collect(*root_, root_cube_, node_may_meet, out);
+        if (has_root_) collect(root_, root_cube_, node_may_meet, out);
     }
 
     /// The polygons, in the order given to the constructor (Hit::polygon indexes them).
@@ -161,40 +175,87 @@ public:
     const Options& options() const { return options_; }
 
 private:
-    struct Node;
+    // A cube of the tree, 8 bytes. An internal node's children are the nodes of its block,
+    // blocks_[first].child[i] for the octants i with bit i of child_mask() set; a leaf lists the
+    // ray records leaf_records_[first .. first + count()).
+    struct Node {
+        int first = 0;  // internal: index of its block; leaf: start of its list
+        int code = 0;   // leaf: count() >= 0; internal: -1 - child_mask()
+        static Node leaf(int first, int count) { return Node{first, count}; }
+        static Node internal(int block, unsigned mask) {
+            return Node{block, -1 - static_cast<int>(mask)};
+        }
+        bool is_leaf() const { return code >= 0; }
+        int count() const { return code; }
+        unsigned child_mask() const { return static_cast<unsigned>(-1 - code); }
+    };
+    // An internal node's cube and its eight children (slot i is octant i, unused where the node
+    // has no child there): two cache lines, all that a visit of the node reads of the tree.
+    struct alignas(128) Block {
+        std::array<Node, 8> child;
+        Box3 cube;  // the internal node's cube (not grown by the margin)
+    };
+    // What the ray-polygon test reads of one polygon, packed: copies of Polygon's plane, slack
+    // and bounding planes (inline up to four, else extra_planes_[first_extra ..]), its surface
+    // and its index in polygons_.
+    struct alignas(64) RayRecord {
+        Plane plane;
+        double slack = 0;
+        int polygon = -1;
+        int surface = -1;
+        int n_planes = 0;
+        int first_extra = 0;
+        std::array<Plane, 4> planes;
+        const Plane* bounding(const std::vector<Plane>& extra) const {
+            return n_planes <= 4 ? planes.data() : extra.data() + first_extra;
+        }
+    };
+    static Box3 child_cube(const Box3& cube, int i);
     struct Query;
-    std::unique_ptr<Node> build(const Box3& cube, std::vector<int> ids, int depth);
+    struct ChildHits;
+    struct Numbering;
+    Node build(const Box3& cube, std::vector<int> ids, int depth, Numbering& numbering);
+    void make_records(Numbering& numbering);
     Box3 grown(const Box3& cube) const;
-    bool traverse(const Node& node, const Box3& cube, Query& query) const;
+    bool traverse(const Node& node, Query& query) const;
+    bool test_leaf(const Node& node, Query& query) const;
+    ChildHits child_hits(const Block& block, unsigned mask, const Query& query) const;
     template <class NodeTest>
     void collect(const Node& node, const Box3& cube, NodeTest& test, std::vector<int>& out) const;
-    static bool node_is_leaf(const Node& node);
-    static const std::vector<int>& node_polygons(const Node& node);
-    static const Node* node_child(const Node& node, int i);
-    static Box3 node_child_cube(const Box3& cube, int i);
 
     std::vector<Polygon> polygons_;
     Options options_;
     Box3 root_cube_;
-    double margin_ = 0;  // every node cube grows by this much for building and traversal
-    std::unique_ptr<Node> root_;
+    double margin_ = 0;          // every node cube grows by this much for building and traversal
+    Box3 grown_root_;            // grown(root_cube_)
+    bool has_root_ = false;      // false for an empty tree
+    Node root_;                  // the root (its cube is root_cube_)
+    std::vector<Block> blocks_;  // the internal nodes' blocks, in depth-first order
+    std::vector<int> leaf_records_;    // the leaves' lists of record numbers, one after another
+    std::vector<RayRecord> records_;   // in the order the leaves first list them
+    std::vector<int> record_polygon_;  // records_[r].polygon, compact (for collect)
+    std::vector<Plane> extra_planes_;  // bounding planes of polygons with more than four
     int node_count_ = 0;
     int leaf_count_ = 0;
     int depth_ = 0;
     long reference_count_ = 0;
 };
 
+// `cube` is the node's cube (a leaf's is not stored: it is split from its parent's, as the build
+// split it).
 template <class NodeTest>
 void Octree::collect(const Node& node, const Box3& cube, NodeTest& test,
                      std::vector<int>& out) const {
     if (!test(grown(cube))) return;
-    if (node_is_leaf(node)) {
-        const std::vector<int>& ids = node_polygons(node);
-        out.insert(out.end(), ids.begin(), ids.end());
+    if (node.is_leaf()) {
+        for (int r = node.first, end = node.first + node.count(); r < end; ++r)
+            out.push_back(record_polygon_[leaf_records_[r]]);
         return;
     }
+    const Block& block = blocks_[node.first];
     for (int i = 0; i < 8; ++i)
-        if (const Node* child = node_child(node, i)) collect(*child, node_child_cube(cube, i), test, out);
+        if ((node.child_mask() >> i) & 1)
+            collect(block.child[i], child_cube(block.cube, i), test, out);
 }
 
 }  // namespace mbr

@@ -2,12 +2,11 @@
 // ray-polygon test (section 6, "Octree"); plus (u, v) interpolation for hit points.
 #include "octree/polygon.h"
 
-#include "math/convex2d.h"
-
 #include <algorithm>
 #include <cmath>
 
 #include "math/check.h"
+#include "math/convex2d.h"
 
 namespace mbr {
 
@@ -106,20 +105,12 @@ Polygon::Polygon(std::vector<Vec3> vertices, std::vector<Vec2> uv, int surface)
 bool Polygon::contains(Vec3 p) const {
     // Step 2 of the paper's test: substitute p into each bounding plane's equation. The paper asks
     // for all results negative (open polygon); we accept up to +edge_slack_ (closed, see header).
-    // Written as !(d <= slack) so that a NaN counts as outside.
-    for (const Plane& b : bounding_planes_)
-        if (!(b.signed_distance(p) <= edge_slack_)) return false;
-    return true;
+    return inside_bounding_planes(bounding_planes_.data(), n_vertices(), edge_slack_, p);
 }
 
 std::optional<double> Polygon::intersect(const Ray& ray) const {
-    // Step 1: the ray meets the polygon's plane at t = (offset - n.o) / n.d.
-    double denom = dot(plane_.normal, ray.dir);
-    if (denom == 0) return std::nullopt;  // parallel (or in the plane): a miss by convention
-    double t = -plane_.signed_distance(ray.origin) / denom;
-    if (!std::isfinite(t) || t < ray.t_min || t > ray.t_max) return std::nullopt;
-    if (!contains(ray.at(t))) return std::nullopt;
-    return t;
+    // Steps 1 and 2 of the paper's test, in the function the octree calls on its packed copy.
+    return intersect_planes(plane_, bounding_planes_.data(), n_vertices(), edge_slack_, ray);
 }
 
 void Polygon::set_thickness(double thickness) {

@@ -61,6 +61,39 @@ struct Plane {
     double signed_distance(Vec3 p) const { return dot(normal, p) - offset; }
 };
 
+/// Step 2 of the paper's ray-polygon test on bare planes: p, taken to lie in the polygon's plane,
+/// is on the inner side of each of the n bounding planes, by at most `slack` outside (closed).
+/// Written as !(d <= slack) so that a NaN counts as outside.
+inline bool inside_bounding_planes(const Plane* bounding, int n, double slack, Vec3 p) {
+    for (int i = 0; i < n; ++i)
+        if (!(bounding[i].signed_distance(p) <= slack)) return false;
+    return true;
+}
+
+/// Step 1 of the paper's ray-polygon test: the t at which the ray meets the plane,
+/// (offset - n.o) / n.d; infinite or NaN when the ray is parallel to the plane (or in it).
+inline double plane_crossing(const Plane& plane, const Ray& ray) {
+    return -plane.signed_distance(ray.origin) / dot(plane.normal, ray.dir);
+}
+
+/// Whether a plane_crossing() counts: finite (a ray parallel to the plane, or in it, misses by
+/// convention) and in [t_min, t_max].
+inline bool crossing_within(double t, const Ray& ray) {
+    return std::isfinite(t) && !(t < ray.t_min) && !(t > ray.t_max);
+}
+
+/// The paper's ray-polygon test (section 6, "Octree") on bare planes: the ray meets `plane` at
+/// t = plane_crossing(), a miss unless crossing_within(); the hit point is inside iff
+/// inside_bounding_planes() holds. Polygon::intersect and the octree's packed copy of the planes
+/// (octree.h) both use these three functions, so they return the same t bit for bit.
+inline std::optional<double> intersect_planes(const Plane& plane, const Plane* bounding, int n,
+                                              double slack, const Ray& ray) {
+    const double t = plane_crossing(plane, ray);
+    if (!crossing_within(t, ray)) return std::nullopt;
+    if (!inside_bounding_planes(bounding, n, slack, ray.at(t))) return std::nullopt;
+    return t;
+}
+
 /// A planar convex polygon of a surface's tessellation: vertices counter-clockwise seen from the
 /// front, the (u, v) of each vertex on its surface, and the surface's id; with its plane and its
 /// bounding planes (Figure 6) precomputed.

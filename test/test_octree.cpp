@@ -685,6 +685,61 @@ TEST_CASE("octree: a cluster in one corner is subdivided", "[octree]") {
     CHECK(stats.n_polygons_tested < 40 * 10);  // not all forty per ray
 }
 
+TEST_CASE("octree: region queries see every node's grown cube", "[octree]") {
+    // polygons_near and append_polygons_near walk the stored tree: a test that accepts
+    // everything is asked once per node, and the leaves' lists add up to reference_count().
+    // The cubes it is shown are the nodes' cubes grown by the margin: the root's first, each
+    // other inside an earlier one at half its side. A polygon that meets the region (exact
+    // clipping) is always returned.
+    const unsigned seed = 515;
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> u01(0, 1);
+    const std::vector<Polygon> scene = random_scene(rng, 900);
+    const Octree octree(scene, Octree::Options{8, 4});
+    std::vector<Box3> cubes;
+    std::vector<int> all;
+    octree.append_polygons_near(
+        [&](const Box3& c) {
+            cubes.push_back(c);
+            return true;
+        },
+        all);
+    CHECK(static_cast<int>(cubes.size()) == octree.node_count());
+    CHECK(static_cast<long>(all.size()) == octree.reference_count());
+    CHECK(octree.polygons_near([](const Box3&) { return true; }).size() == scene.size());
+    const double root_side = octree.bounds().extent().x;
+    REQUIRE(!cubes.empty());
+    const double margin = 0.5 * (cubes[0].extent().x - root_side);
+    CHECK(margin > 0);
+    CHECK(margin < 1e-6 * root_side);
+    for (size_t i = 1; i < cubes.size(); ++i) {
+        CAPTURE(i, cubes[i]);
+        const double side = cubes[i].extent().x - 2 * margin;
+        bool has_parent = false;
+        for (size_t j = i; j-- > 0 && !has_parent;) {
+            const double parent = cubes[j].extent().x - 2 * margin;
+            has_parent = std::fabs(side - 0.5 * parent) <= 1e-9 * root_side &&
+                         cubes[i].lo.x >= cubes[j].lo.x && cubes[i].hi.x <= cubes[j].hi.x &&
+                         cubes[i].lo.y >= cubes[j].lo.y && cubes[i].hi.y <= cubes[j].hi.y &&
+                         cubes[i].lo.z >= cubes[j].lo.z && cubes[i].hi.z <= cubes[j].hi.z;
+        }
+        CHECK(has_parent);
+    }
+    for (int r = 0; r < 200; ++r) {
+        const Vec3 lo{10 * u01(rng), 10 * u01(rng), 10 * u01(rng)};
+        const double s = 2 * u01(rng) * u01(rng);
+        const Box3 region{lo, lo + Vec3{s, 0.5 * s, s}};
+        const std::vector<int> near =
+            octree.polygons_near([&](const Box3& c) { return overlaps(c, region); });
+        CHECK(std::is_sorted(near.begin(), near.end()));
+        for (int id = 0; id < static_cast<int>(scene.size()); ++id)
+            if (clip_reference_meets(region, scene[id].vertices())) {
+                CAPTURE(r, id);
+                CHECK(std::binary_search(near.begin(), near.end(), id));
+            }
+    }
+}
+
 TEST_CASE("octree: concurrent queries agree with sequential ones", "[octree]") {
     const unsigned seed = 66;
     std::mt19937 rng(seed);
@@ -756,7 +811,8 @@ TEST_CASE("octree: a hit within a polygon's thickness of a segment's end does no
 
     // The octree applies the rule only when asked (RayFilter::ends_on_surfaces): behind the facet
     // lies an exact polygon the segment also crosses, which then is the first hit.
-    const Polygon behind = make_polygon({{0, 0, -0.2}, {1, 0, -0.2}, {1, 1, -0.2}, {0, 1, -0.2}}, 1);
+    const Polygon behind =
+        make_polygon({{0, 0, -0.2}, {1, 0, -0.2}, {1, 1, -0.2}, {0, 1, -0.2}}, 1);
     const Octree octree({facet, behind});
     const Ray down = segment({0.5, 1.05, 0.02}, {0.5, 0.2, -0.3});
     const RayFilter between{-1, -1, true};
