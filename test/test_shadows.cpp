@@ -305,3 +305,83 @@ TEST_CASE("shadow: after shadow subdivision no leaf is more than twice its twelv
                         << run.state.stats.n_shadow_splits << " shadow splits, " << n_checked
                         << " neighbour pairs checked\n";
 }
+
+TEST_CASE(
+    "shadow: splits follow power: a leaf splits only while its area times the largest "
+    "sample reaches the tolerance times split_area",
+    "[shadow][shadows]") {
+    // worth_splitting (shadows.cpp): with ShadowOptions::split_area set so that the bound falls
+    // between the leaves of level L and L + 1, shadow subdivision stops at level L + 1 (leaves
+    // of level L still split) where without it the same transfer reaches the shadow depth; the
+    // fractions it computes are fewer. The samples come before stage 7, so max_sample is the same
+    // in every run.
+    const ShadowSetup setup = occluded_squares(0);
+    const Pair pair(setup);
+    ReceiverOptions options = small_options(ShadowMethod::Fractions);
+    options.shadows.max_depth = 5;
+    const Run probe = run_transfer(setup, options, &pair.context);
+    const double S = probe.state.max_sample;
+    REQUIRE(S > 0);
+    options.absolute_tolerance = 1e-9 * S;  // changes no other test of the transfer
+    auto finest = [](const Run& run) {
+        int level = 0;
+        for (int index : run.state.forest.leaves(Forest::Region::Domain))
+            level = std::max(level, run.state.forest.node(index).cell.level);
+        return level;
+    };
+    const Run full = run_transfer(setup, options, &pair.context);
+    CHECK(finest(full) == options.shadows.max_depth);
+    CHECK(full.state.stats.n_fractions == probe.state.stats.n_fractions);
+    const double area = setup.receiver.area();
+    for (int L : {2, 3}) {
+        CAPTURE(L);
+        ReceiverOptions limited = options;
+        limited.shadows.split_area =
+            area * std::pow(0.25, L) * S / options.absolute_tolerance * (1 - 1e-9);
+        const Run run = run_transfer(setup, limited, &pair.context);
+        CHECK(finest(run) == L + 1);
+        CHECK(run.state.stats.n_fractions < full.state.stats.n_fractions);
+        CHECK(run.state.stats.n_shadow_splits < full.state.stats.n_shadow_splits);
+    }
+}
+
+TEST_CASE("shadow: a fraction's rays follow energy when the partition is finer than the budget",
+          "[shadow][shadows]") {
+    // patch_rays (shadows.cpp): a weak transfer (largest sample 8 times the tolerance) asks for
+    // 4^1 patches of 4 rays, 16 in all (patch_depth); the adaptive partition of (21) at the
+    // receiver's centre has more patches than 16 / 4, so the 16 rays are spread over them by
+    // energy with unbiased weights. The half-view scene of the test above: the fraction is 1/2
+    // in expectation; each estimate casts 16 rays (systematic sampling: exactly the budget, up
+    // to rounding) and their mean over 200 seeds is within 4 standard errors of 1/2 (each
+    // estimate's variance is about 1/(4 x 16)). The shooter is lowered to z = 0.1 (the occluder
+    // to 0.05), so that the kernel at the centre is peaked and the partition fine.
+    ShadowSetup setup = squares_with({{{-1, -1, 0.05}, {3, -1, 0.05}, {3, 3, 0.05}}});
+    setup.shooter = Surface::planar_quad({0, 0, 0.1}, {0, 1, 0.1}, {1, 1, 0.1}, {1, 0, 0.1});
+    ReceiverOptions options = small_options(ShadowMethod::Fractions);
+    const double S = 1.0;
+    options.absolute_tolerance = S / 8;
+    const Shooter shooter = unit_shooter(setup.shooter);
+    const ReceiverSurface receiver{&setup.receiver, [](double, double) { return Rgb{1, 1, 1}; }};
+    IncrementSampler sampler(shooter, receiver, options.quadrature);
+    const SurfacePoint p = setup.receiver.evaluate(0.5, 0.5);
+    const IncrementIntegrator::Result r = sampler.integrator(0).integrate(p, true, 1, false);
+    REQUIRE(r.partition.size() > 4);  // finer than the budget's 4 patches
+    const int n_seeds = 200;
+    double sum = 0;
+    for (int shot = 0; shot < n_seeds; ++shot) {
+        const Pair pair(setup, shot);
+        ReceiverState state(options, 0, &pair.context);
+        state.max_sample = S;
+        const Rgb f = fraction_at(state, sampler, 0.5, 0.5, 0);
+        CAPTURE(shot, f);
+        CHECK(state.stats.n_rays >= 15);
+        CHECK(state.stats.n_rays <= 17);
+        CHECK(f.r >= 0);
+        CHECK(f.r <= 1);
+        sum += f.r;
+    }
+    const double mean = sum / n_seeds;
+    CHECK(std::fabs(mean - 0.5) <= 4 * std::sqrt(1.0 / (4 * 16) / n_seeds));
+    mbr::test::report() << "fraction rays by energy: " << r.partition.size()
+                        << " patches, 16 rays; mean over " << n_seeds << " seeds " << mean << "\n";
+}

@@ -341,6 +341,8 @@ ProgressiveSolver::ProgressiveSolver(const Scene& scene, const Octree& octree,
     const double area = scene.total_area();
     radiosity_scale_ =
         area > 0 ? std::max({emitted_rgb.r, emitted_rgb.g, emitted_rgb.b}) / area : 0;
+    for (const SceneSurface& s : scene.surfaces)
+        largest_area_ = std::max(largest_area_, s.surface.area());
 }
 
 const std::vector<double>& ProgressiveSolver::power_weights(int surface, int level) const {
@@ -586,6 +588,9 @@ ShotStats ProgressiveSolver::shoot() {
     ReceiverOptions ro = options_.receiver;
     ro.absolute_tolerance = options_.tolerance * radiosity_scale_;
     ro.quadrature.abs_tolerance = options_.quadrature_share * ro.absolute_tolerance;
+    // Shadow splits follow power (shadows.cpp, worth_splitting): against a finest cell of the
+    // scene's largest surface.
+    ro.shadows.split_area = largest_area_ * std::pow(0.25, ro.max_depth);
     const SplineField& unshot_h = solution_.unshot[h];
     const int coarsen = std::max(ro.shooter_coarsening, unshot_h.level() - options_.shooter_level);
     const Shooter shooter = make_shooter(scene_.surfaces[h].surface, unshot_h, coarsen);

@@ -179,6 +179,7 @@ private:
     /// The ambient correction of SolverOptions::ambient, per surface: a constant radiosity.
     std::vector<Rgb> ambient_correction() const;
     double radiosity_scale_ = 0;
+    double largest_area_ = 0;  // of the scene's surfaces (the shadow split rule's scale)
     double start_seconds_ = 0;
     /// Power weights w_kl = int int N_k N_l A per surface and level (cached).
     const std::vector<double>& power_weights(int surface, int level) const;

@@ -35,6 +35,9 @@ struct ShadowOptions {
     double threshold = 0.05;  // fractions of neighbouring fulcrums differing by more split the
                               //   leaves between them (largest channel)
     int max_depth = 6;        // shadow subdivision stops at leaves of this level
+    double split_area = 0;    // > 0: a leaf splits only if its area times the largest sample
+                              //   reaches absolute_tolerance times this (shadows.cpp,
+                              //   worth_splitting; the solver sets it)
     bool kernel_weighted = false;  // beyond the paper: r_i of (28) weights each ray by the
                                    //   kernel (3) times A (4) at its end (scenes: `set
                                    //   fraction_rays kernel`, their default)
@@ -140,6 +143,7 @@ struct TransferStats {
     int n_refined = 0;               // coefficients obtained by (17) during unification
     int level = 0;                   // the unified level j of the result
     double rhombus_radius = 0;       // in cells
+    double max_sample = 0;           // largest |dB| of the domain's samples (ReceiverState's)
     long n_rays = 0;                 // shadow rays (fractions (28), or per node on curved shooters)
     int n_fractions = 0;             // fractions (28) evaluated
     int n_shadow_splits = 0;         // leaves split by shadow subdivision (and scale adjustment)
