@@ -141,10 +141,11 @@ TEST_CASE("shadow: an occluder hiding half of a point's view gives a fraction ne
     const SurfacePoint p = setup.receiver.evaluate(0.5, 0.5);
 
     // The partition (28) uses at p, and the statistics above.
-    const IncrementIntegrator::Result r = sampler.integrator(0).integrate(p, true, min_patch_depth);
+    const std::vector<AcceptedCell<Rgb>> partition =
+        sampler.integrator(0).fraction_partition(p, min_patch_depth, nullptr);
     double E = 0, sum_e2_diag = 0;
     int n_diag = 0;
-    for (const auto& patch : r.partition) {
+    for (const auto& patch : partition) {
         const Rect& c = patch.cell.rect;
         E += patch.value.r;
         if (c.x0 - c.y1 < 0 && c.x1 - c.y0 > 0) {  // the diagonal u = v cuts it
@@ -198,7 +199,7 @@ TEST_CASE("shadow: an occluder hiding half of a point's view gives a fraction ne
         0.5 * point_polygon_form_factor(p.position, p.normal, quad_polygon(setup.shooter));
     const double I = exact_integrator.integrate(p).value.r;
     CHECK(I == Approx(half).epsilon(1e-4));
-    mbr::test::report() << "shadow fraction (28), half view: " << r.partition.size() << " patches, "
+    mbr::test::report() << "shadow fraction (28), half view: " << partition.size() << " patches, "
                         << n_diag << " cut; sigma stratified " << std::sqrt(var_stratified)
                         << " (unstratified " << std::sqrt(var_plain) << "), Hoeffding bound "
                         << t_hoeffding << "; over " << n_seeds << " seeds: mean " << mean
@@ -364,8 +365,9 @@ TEST_CASE("shadow: a fraction's rays follow energy when the partition is finer t
     const ReceiverSurface receiver{&setup.receiver, [](double, double) { return Rgb{1, 1, 1}; }};
     IncrementSampler sampler(shooter, receiver, options.quadrature);
     const SurfacePoint p = setup.receiver.evaluate(0.5, 0.5);
-    const IncrementIntegrator::Result r = sampler.integrator(0).integrate(p, true, 1, false);
-    REQUIRE(r.partition.size() > 4);  // finer than the budget's 4 patches
+    const std::vector<AcceptedCell<Rgb>> partition =
+        sampler.integrator(0).fraction_partition(p, 1, nullptr);
+    REQUIRE(partition.size() > 4);  // finer than the budget's 4 patches
     const int n_seeds = 200;
     double sum = 0;
     for (int shot = 0; shot < n_seeds; ++shot) {
@@ -382,6 +384,51 @@ TEST_CASE("shadow: a fraction's rays follow energy when the partition is finer t
     }
     const double mean = sum / n_seeds;
     CHECK(std::fabs(mean - 0.5) <= 4 * std::sqrt(1.0 / (4 * 16) / n_seeds));
-    mbr::test::report() << "fraction rays by energy: " << r.partition.size()
+    mbr::test::report() << "fraction rays by energy: " << partition.size()
                         << " patches, 16 rays; mean over " << n_seeds << " seeds " << mean << "\n";
+}
+
+TEST_CASE("shadow: a fraction's partition is the uniform grid, split near the point",
+          "[shadow][shadows]") {
+    // fraction_partition (sample_values.h): far from the shooter, exactly the 2^d x 2^d grid;
+    // close to it, the cells near the point's foot split (the near-field guard) down to at most
+    // max_fraction_depth. Either way the cells tile the shooter's [0,1]^2 and their energies add
+    // up to I(p) (the adaptive rule of (21), 1e-4 relative) within 1 % (one n-point rule per
+    // cell instead of (21)'s refinement).
+    const ShadowSetup setup = occluded_squares(0);
+    const ReceiverOptions options = small_options(ShadowMethod::Fractions);
+    for (double h : {1.0, 0.02}) {
+        CAPTURE(h);
+        const Surface shooter_surface =
+            Surface::planar_quad({0, 0, h}, {0, 1, h}, {1, 1, h}, {1, 0, h});
+        const Shooter shooter = unit_shooter(shooter_surface);
+        const ReceiverSurface receiver{&setup.receiver, [](double, double) {
+                                           return Rgb{1, 1, 1};
+                                       }};
+        IncrementSampler sampler(shooter, receiver, options.quadrature);
+        const SurfacePoint p = setup.receiver.evaluate(0.3, 0.6);
+        long n_evals = 0;
+        const std::vector<AcceptedCell<Rgb>> partition =
+            sampler.integrator(0).fraction_partition(p, 3, &n_evals);
+        double area = 0, energy = 0;
+        int deepest = 0;
+        for (const AcceptedCell<Rgb>& patch : partition) {
+            area += patch.cell.rect.area();
+            energy += patch.value.r;
+            deepest = std::max(deepest, patch.cell.level);
+            CHECK(patch.cell.level >= 3);
+        }
+        CHECK(area == Approx(1).epsilon(1e-12));
+        CHECK(deepest <= max_fraction_depth);
+        CHECK(n_evals >= static_cast<long>(partition.size()));
+        if (h == 1.0) CHECK(partition.size() == 64);
+        if (h < 1) CHECK(partition.size() > 64);
+        QuadratureOptions accurate;
+        IncrementIntegrator reference(shooter, accurate);
+        const double I = reference.integrate(p).value.r;
+        CHECK(energy == Approx(I).epsilon(0.01));
+        mbr::test::report() << "fraction partition at height " << h << ": " << partition.size()
+                            << " patches, deepest level " << deepest << ", energy " << energy
+                            << " against I(p) " << I << "\n";
+    }
 }

@@ -3,6 +3,7 @@
 #include "radiosity/transfer/sample_values.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "math/check.h"
@@ -585,18 +586,7 @@ IncrementIntegrator::Result IncrementIntegrator::integrate(const SurfacePoint& p
             std::find(mixed_.begin(), mixed_.end(), cell_key(cell)) != mixed_.end() &&
             (!ray_visibility || cell.level < options_.max_visibility_depth))
             return true;  // its nodes disagree on visibility, or a coarse cut cell: split
-        if (near_field <= 0) return false;
-        // The cell's extent: its nodes and its corners (the nodes alone leave a gap along the
-        // cell's edges, where a peak between two cells would escape both).
-        const PointSpan pts = points(cell, options_.n + 1);
-        Box3 box;
-        for (int i = 0; i < pts.count; ++i) box.extend(pts.first[i].x);
-        const Rect& r = cell.rect;
-        for (const Vec2 c :
-             {Vec2{r.x0, r.y0}, Vec2{r.x1, r.y0}, Vec2{r.x0, r.y1}, Vec2{r.x1, r.y1}})
-            box.extend(shooter_.surface->point(c.x, c.y));
-        const Vec3 gap = max(max(box.lo - p.position, p.position - box.hi), Vec3{0, 0, 0});
-        return length(box.extent()) > near_field * length(gap);
+        return too_near(p, cell, near_field);
     };
     auto r = adaptive_tensor_rule_2d(cell_rule, root.rect, opt, keep_partition, near);
     result.value = r.value + exact_part - shadowed;
@@ -607,6 +597,58 @@ IncrementIntegrator::Result IncrementIntegrator::integrate(const SurfacePoint& p
     result.converged = r.converged;
     result.partition = std::move(r.cells);
     return result;
+}
+
+bool IncrementIntegrator::too_near(const SurfacePoint& p, const QuadCell& cell, double near_field) {
+    if (near_field <= 0) return false;
+    // The cell's extent: its nodes and its corners (the nodes alone leave a gap along the
+    // cell's edges, where a peak between two cells would escape both).
+    const PointSpan pts = points(cell, options_.n + 1);
+    Box3 box;
+    for (int i = 0; i < pts.count; ++i) box.extend(pts.first[i].x);
+    const Rect& r = cell.rect;
+    for (const Vec2 c : {Vec2{r.x0, r.y0}, Vec2{r.x1, r.y0}, Vec2{r.x0, r.y1}, Vec2{r.x1, r.y1}})
+        box.extend(shooter_.surface->point(c.x, c.y));
+    const Vec3 gap = max(max(box.lo - p.position, p.position - box.hi), Vec3{0, 0, 0});
+    return length(box.extent()) > near_field * length(gap);
+}
+
+std::vector<AcceptedCell<Rgb>> IncrementIntegrator::fraction_partition(const SurfacePoint& p,
+                                                                       int depth,
+                                                                       long* n_evaluations) {
+    std::vector<AcceptedCell<Rgb>> out;
+    set_view(p);
+    if (view_.behind_all) return out;
+    const int n = options_.n;
+    std::vector<QuadCell> todo;
+    const int side = 1 << depth;
+    for (int j = side - 1; j >= 0; --j)
+        for (int i = side - 1; i >= 0; --i)
+            todo.push_back(QuadCell{depth, i, j,
+                                    Rect{double(i) / side, double(i + 1) / side, double(j) / side,
+                                         double(j + 1) / side}});
+    long n_evals = 0;
+    while (!todo.empty()) {
+        const QuadCell cell = todo.back();
+        todo.pop_back();
+        const size_t n_mixed = mixed_.size();
+        bool split = cell.level < max_fraction_depth && too_near(p, cell, near_field_guard);
+        Rgb value;
+        if (!split) {
+            value = cell_value(p, cell, n);
+            n_evals += long(n) * n;
+            // A coarse cut cell is split without a value (cell_value's rule).
+            split = mixed_.size() > n_mixed && cell.level < max_fraction_depth;
+        }
+        if (!split) {
+            out.push_back({cell, value});
+            continue;
+        }
+        const std::array<QuadCell, 4> children = quad_children(cell);
+        todo.insert(todo.end(), children.rbegin(), children.rend());
+    }
+    if (n_evaluations) *n_evaluations += n_evals + extra_evaluations_;
+    return out;
 }
 
 Rgb IncrementIntegrator::integrate_on(const SurfacePoint& p,

@@ -39,6 +39,9 @@ constexpr double near_field_guard_subtracted = 0;
 /// pieces are integrated (the root's pieces would be many; deeper cells are split by the error
 /// test when their pieces disagree).
 constexpr int min_cut_level = 1;
+/// The deepest patch of a fraction's partition (fraction_partition): about 1e-4 of the
+/// shooter's side, far below what the fraction's few hundred rays resolve.
+constexpr int max_fraction_depth = 14;
 
 /// Options of the adaptive quadrature of (21) over the shooter (section 6).
 struct QuadratureOptions {
@@ -162,6 +165,15 @@ public:
     /// whether (and what) it subtracted: the same constant is subtracted here.
     Rgb integrate_on(const SurfacePoint& p, const std::vector<AcceptedCell<Rgb>>& partition,
                      long* n_evaluations, long* n_rays = nullptr, const Result* made_by = nullptr);
+    /// The shooter partition of a visible fraction (28) at p, with each patch's energy toward p
+    /// (its n-point rule): the uniform 2^depth x 2^depth grid, the paper's fixed partition, with
+    /// the cells too near p for their size (the near-field guard of integrate) and the horizon's
+    /// coarse cut cells split further, down to max_fraction_depth. The energies only weigh the
+    /// patches' rays, so one rule per cell suffices (not the n against n + 1 refinement of (21),
+    /// whose partition near a contact or a horizon has thousands of cells). Adds the kernel
+    /// evaluations to *n_evaluations.
+    std::vector<AcceptedCell<Rgb>> fraction_partition(const SurfacePoint& p, int depth,
+                                                      long* n_evaluations);
     /// Points the tensor cache has room for now (at most max_cached_points).
     size_t cached_point_capacity() const { return pool_.capacity(); }
     /// The points of a cell for the n-point rule (cached): n*n points from `first`, valid until
@@ -191,6 +203,9 @@ private:
     /// (ray visibility: a curved shooter, or too many occluders to project).
     void collect_shaft_occluders(const SurfacePoint& p, const QuadCell& cell, const PointSpan& pts);
     void set_view(const SurfacePoint& p);
+    /// The near-field guard: the cell's nodes and corners span more than near_field times their
+    /// distance from p (its rule cannot be trusted there).
+    bool too_near(const SurfacePoint& p, const QuadCell& cell, double near_field);
     ConvexPolygon cell_image(const QuadCell& cell) const;
     Rgb pieces_value(const SurfacePoint& p, const std::vector<ConvexPolygon>& pieces, int n);
     Rgb triangle_value(const SurfacePoint& p, Vec2 a, Vec2 b, Vec2 c, int n);
@@ -223,8 +238,8 @@ private:
     // Splitting every such cell down to max_visibility_depth made ~20000 cells (max_cells) for
     // each receiving point near a shadow's edge on a curved shooter: a disk lamp over a cylinder
     // on a floor did not finish its first shot in 300 s.
-    double mixed_tolerance_ = 0;  // integrate's tolerance with ray visibility, else 0
-    std::uint64_t pieces_key_ = ~0ULL;     // the cut cell whose pieces are in pieces_
+    double mixed_tolerance_ = 0;        // integrate's tolerance with ray visibility, else 0
+    std::uint64_t pieces_key_ = ~0ULL;  // the cut cell whose pieces are in pieces_
     std::vector<ConvexPolygon> pieces_;
     PolynomialPatches unshot_patches_;     // B_h for scattered points (cut pieces)
     std::optional<Plane> receiver_plane_;  // set_receiver_plane

@@ -96,8 +96,9 @@ PatchRays patch_rays(const std::vector<AcceptedCell<Rgb>>& partition, int rays_p
     return out;
 }
 
-/// Eq. (28) at the domain point (s, t), computed (no memo): rays to random points of every
-/// patch of the shooter partition that (21)'s adaptive quadrature forms there.
+/// Eq. (28) at the domain point (s, t), computed (no memo): rays to random points of the
+/// patches of the shooter partition (IncrementIntegrator::fraction_partition), weighed by the
+/// energy each sends to the point.
 Rgb compute_fraction(const ReceiverState& state, IncrementSampler& sampler, Vec2 point,
                      double inset, int thread, long* n_rays, long* n_evals) {
     const OcclusionContext& ctx = *state.occlusion;
@@ -118,19 +119,19 @@ Rgb compute_fraction(const ReceiverState& state, IncrementSampler& sampler, Vec2
         toward = occluders_toward(ctx, *plane, p.position, max_listed_occluders);
         if (toward.empty()) return {1, 1, 1};
     }
-    const IncrementIntegrator::Result r = integrator.integrate(p, true, patch_depth(state), false);
-    *n_evals += r.n_evaluations;
+    const std::vector<AcceptedCell<Rgb>> partition =
+        integrator.fraction_partition(p, patch_depth(state), n_evals);
     const int n_rays_per_patch = state.options.shadows.rays_per_patch;
     const Surface& shooter = *sampler.shooter().surface;
     // DESIGN: the rays of a point are seeded from its position (a fulcrum's (level, k, l) in
     // lowest terms: two fulcrums at one point share the fraction), the pair and the shot.
     const std::uint64_t point_key = hash_seed(ctx.seed, bits(point.x), bits(point.y));
     const long budget = (1L << (2 * patch_depth(state))) * n_rays_per_patch;
-    const PatchRays rays = patch_rays(r.partition, n_rays_per_patch, budget,
-                                      hash_seed(point_key, r.partition.size(), 1));
+    const PatchRays rays =
+        patch_rays(partition, n_rays_per_patch, budget, hash_seed(point_key, partition.size(), 1));
     Rgb num, den;
-    for (size_t i = 0; i < r.partition.size(); ++i) {
-        const AcceptedCell<Rgb>& patch = r.partition[i];
+    for (size_t i = 0; i < partition.size(); ++i) {
+        const AcceptedCell<Rgb>& patch = partition[i];
         const Rgb e = patch.value;  // energy the patch shoots toward p
         if (max_abs(e) == 0) continue;
         const int n_patch_rays = rays.count[i];
