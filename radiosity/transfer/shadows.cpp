@@ -54,9 +54,9 @@ int patch_depth(const ReceiverState& state) {
 
 /// How many of a fraction's rays go to each patch of the shooter partition (effort follows
 /// energy; DESIGN, docs/method.md "Shadow rays follow energy"). The standard error that
-/// patch_depth() accepts is that of `budget` = 4^d R rays. The adaptive partition of (21) can be
-/// far finer than 4^d near the receiving point (a ball resting on the floor: thousands of floor
-/// patches), and R rays to each would buy visibility that the energy does not ask for. So when
+/// patch_depth() accepts is that of `budget` = 4^d R rays. The partition (fraction_partition)
+/// is finer than 4^d near a receiving point close to the shooter (a ball resting on the floor),
+/// and R rays to each patch would buy visibility that the energy does not ask for. So when
 /// the partition has more than budget / R patches (with energy), the budget is spread by the
 /// patches' energy |e_i| (channel sum) with systematic sampling from a seeded offset: patch i
 /// gets n_i rays, about budget |e_i| / sum |e|, and counts in (28) with the weight n_i / (that
@@ -308,9 +308,6 @@ std::set<int> leaves_across_shadow_edges(ReceiverState& state, const std::vector
     return marked;
 }
 
-/// Shadow subdivision (section 6, "Shadow"): fractions at every domain leaf's fulcrums; the
-/// leaves between differing ones split, scale-adjusted and resampled, round after round until
-/// none splits or all are at the maximum shadow depth. Returns the domain leaves it made.
 /// Whether a domain leaf of this level that a shadow edge crosses is split: below the shadow
 /// depth, and (effort follows energy; DESIGN, docs/method.md "Shadow splits follow power") when
 /// the power the edge can misplace inside it, at most its area times the transfer's largest
@@ -326,6 +323,9 @@ bool worth_splitting(const ReceiverState& state, const IncrementSampler& sampler
     return leaf_area * state.max_sample >= opt.absolute_tolerance * opt.shadows.split_area;
 }
 
+/// Shadow subdivision (section 6, "Shadow"): fractions at every domain leaf's fulcrums; the
+/// leaves between differing ones split, scale-adjusted and resampled, round after round until
+/// none splits or all are at the maximum shadow depth. Returns the domain leaves it made.
 std::set<int> subdivide_shadows(ReceiverState& state, IncrementSampler& sampler, double inset,
                                 double threshold) {
     const int m = state.options.m;
