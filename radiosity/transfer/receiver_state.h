@@ -143,7 +143,6 @@ struct TransferStats {
     int n_refined = 0;               // coefficients obtained by (17) during unification
     int level = 0;                   // the unified level j of the result
     double rhombus_radius = 0;       // in cells
-    double max_sample = 0;           // largest |dB| of the domain's samples (ReceiverState's)
     long n_rays = 0;                 // shadow rays (fractions (28), or per node on curved shooters)
     int n_fractions = 0;             // fractions (28) evaluated
     int n_shadow_splits = 0;         // leaves split by shadow subdivision (and scale adjustment)

@@ -119,14 +119,15 @@ Rgb compute_fraction(const ReceiverState& state, IncrementSampler& sampler, Vec2
         toward = occluders_toward(ctx, *plane, p.position, max_listed_occluders);
         if (toward.empty()) return {1, 1, 1};
     }
+    const int depth = patch_depth(state);
     const std::vector<AcceptedCell<Rgb>> partition =
-        integrator.fraction_partition(p, patch_depth(state), n_evals);
+        integrator.fraction_partition(p, depth, n_evals);
     const int n_rays_per_patch = state.options.shadows.rays_per_patch;
     const Surface& shooter = *sampler.shooter().surface;
     // DESIGN: the rays of a point are seeded from its position (a fulcrum's (level, k, l) in
     // lowest terms: two fulcrums at one point share the fraction), the pair and the shot.
     const std::uint64_t point_key = hash_seed(ctx.seed, bits(point.x), bits(point.y));
-    const long budget = (1L << (2 * patch_depth(state))) * n_rays_per_patch;
+    const long budget = (1L << (2 * depth)) * n_rays_per_patch;
     const PatchRays rays =
         patch_rays(partition, n_rays_per_patch, budget, hash_seed(point_key, partition.size(), 1));
     Rgb num, den;
@@ -315,11 +316,13 @@ std::set<int> leaves_across_shadow_edges(ReceiverState& state, const std::vector
 /// area of a finest cell on the scene's largest surface). So a small surface, whose leaves are
 /// small in the world, resolves only the shadows that carry power: a stool leg 2 cm thick split
 /// to level 6 had leaves of 0.2 mm.
-bool worth_splitting(const ReceiverState& state, const IncrementSampler& sampler, int level) {
+/// `receiver_area` is the receiving surface's area (computed once by the caller: a bilinear
+/// patch's takes 4096 evaluations).
+bool worth_splitting(const ReceiverState& state, double receiver_area, int level) {
     const ReceiverOptions& opt = state.options;
     if (level >= opt.shadows.max_depth) return false;
     if (opt.shadows.split_area <= 0 || opt.absolute_tolerance <= 0) return true;
-    const double leaf_area = sampler.receiver().surface->area() * std::pow(0.25, level);
+    const double leaf_area = receiver_area * std::pow(0.25, level);
     return leaf_area * state.max_sample >= opt.absolute_tolerance * opt.shadows.split_area;
 }
 
@@ -330,6 +333,7 @@ std::set<int> subdivide_shadows(ReceiverState& state, IncrementSampler& sampler,
                                 double threshold) {
     const int m = state.options.m;
     Forest& forest = state.forest;
+    const double receiver_area = sampler.receiver().surface->area();
     std::set<int> new_leaves;  // domain leaves made by shadow subdivision (node indices)
     for (;;) {
         // Fractions at every domain leaf's fulcrums.
@@ -342,7 +346,7 @@ std::set<int> subdivide_shadows(ReceiverState& state, IncrementSampler& sampler,
         const std::set<int> marked = leaves_across_shadow_edges(state, leaves, threshold);
         std::vector<int> to_split;
         for (int index : marked)
-            if (worth_splitting(state, sampler, forest.node(index).cell.level))
+            if (worth_splitting(state, receiver_area, forest.node(index).cell.level))
                 to_split.push_back(index);
         if (to_split.empty()) break;
         for (int index : to_split) {

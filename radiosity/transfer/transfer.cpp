@@ -89,7 +89,6 @@ SplineField transfer(const Shooter& shooter, const ReceiverSurface& receiver,
             stats.n_leaves = static_cast<int>(state.forest.leaves(Forest::Region::Domain).size());
             state.rhombus_radius = rhombus_radius_for_samples(state, dn);
             stats.rhombus_radius = state.rhombus_radius;
-            stats.max_sample = state.max_sample;
         }
         {
             const StageTimer timer(stats.seconds_boundary);
