@@ -41,6 +41,12 @@ IncrementIntegrator::IncrementIntegrator(const Shooter& shooter, const Quadratur
     if (planar_ && !unshot_constant_) unshot_patches_ = PolynomialPatches(shooter.unshot);
 }
 
+Rgb IncrementIntegrator::shooter_radiosity(double u, double v) const {
+    if (unshot_constant_) return shooter_.unshot.coefficient(0, 0);
+    if (planar_) return unshot_patches_(u, v);
+    return shooter_.unshot.evaluate(u, v);
+}
+
 double IncrementIntegrator::visible_form_factor(const SurfacePoint& p) {
     // The contour formula of the reference (Baum et al. 1989), piece by piece (each convex,
     // counter-clockwise seen from the shooter's front).

@@ -185,6 +185,9 @@ public:
     PointSpan points(const QuadCell& cell, int n);
     /// The shooter's plane when it is a planar quad, else null.
     const ShooterPlane* shooter_plane() const { return planar_ ? &plane_ : nullptr; }
+    /// B_h(u, v), the shooter's unshot radiosity (the field's polynomial patches where it has
+    /// them: one Horner evaluation, for a fraction's rays).
+    Rgb shooter_radiosity(double u, double v) const;
     /// True when integrate() uses the closed form (QuadratureOptions::analytic).
     bool analytic() const { return analytic_; }
     /// Every receiving point lies on this plane (a planar receiver): the horizon is one line,
