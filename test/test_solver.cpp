@@ -565,8 +565,10 @@ TEST_CASE("solver: paper shadows agree with exact ones beside a lamp hung below 
     const struct {
         const char* surface;
         double s, t;
-    } points[] = {{"floor", 0.25, 1 / 6.0}, {"wall_front", 0.5, 0.5},
-                  {"wall_left", 0.5, 0.5},  {"ceiling", 1 / 6.0, 0.25}};
+    } points[] = {{"floor", 0.25, 1 / 6.0},
+                  {"wall_front", 0.5, 0.5},
+                  {"wall_left", 0.5, 0.5},
+                  {"ceiling", 1 / 6.0, 0.25}};
     for (const auto& q : points) {
         const int i = scene.find_surface(q.surface);
         const double a = paper.at(i, q.s, q.t)[0], b = exact.at(i, q.s, q.t)[0];
