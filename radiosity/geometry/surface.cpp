@@ -190,6 +190,26 @@ double Surface::area_factor(double u, double v) const {
     return length(cross(x_u, x_v));
 }
 
+bool Surface::bounded_kernel_at(const SurfacePoint& p) const {
+    // DESIGN: within 1e-9 of the radius of the sphere or cylinder, the normal within 1e-6 of
+    // the radial direction. On a cylinder of radius R, two points an angle phi and a height dz
+    // apart see each other with cosines 2 R sin^2(phi / 2) / r each (concave side), so the
+    // kernel is 4 R^2 sin^4(phi / 2) / (pi r^4) <= 1 / (4 pi R^2).
+    Vec3 radial;
+    if (kind_ == Kind::Sphere) {
+        radial = p.position - p_[0];
+    } else if (kind_ == Kind::Cylinder) {
+        const Vec3 d = p.position - p_[0];
+        radial = d - dot(d, e3_) * e3_;
+    } else {
+        return false;
+    }
+    const double r = length(radial);
+    if (!(std::fabs(r - r1_) <= 1e-9 * r1_)) return false;
+    const double facing = dot(p.normal, radial) / r;  // +1 outward, -1 inward
+    return inward_ ? facing <= -1 + 1e-6 : facing >= 1 - 1e-6;
+}
+
 SurfacePoint Surface::evaluate(double u, double v) const {
     Vec3 x_u, x_v;
     tangents(u, v, x_u, x_v);

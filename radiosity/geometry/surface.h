@@ -64,6 +64,11 @@ public:
     bool is_concave() const {
         return inward_ && (kind_ == Kind::Cylinder || kind_ == Kind::Sphere);
     }
+    /// True when p lies on this patch's whole sphere or cylinder (any angle, any height) and faces
+    /// the way the patch does: the kernel (3) from p to the patch is then bounded, by 1/(4 pi
+    /// R^2) (on a sphere it is that constant on the concave side, zero on the convex one), so
+    /// it has no peak near p that a quadrature's nodes could miss. False for other kinds.
+    bool bounded_kernel_at(const SurfacePoint& p) const;
     /// Total area, the integral of A over [0,1]^2 (closed form where one exists).
     double area() const;
     /// A box containing the whole surface.

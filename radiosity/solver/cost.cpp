@@ -123,14 +123,25 @@ CostEstimate scene_cost(const Scene& scene, const SolverOptions& options, int th
     const double coupling =
         std::min(double(std::max(0, options.max_shots)), n_surfaces) * n_surfaces * sizeof(Rgb);
     fields += coupling;
+    // The occluder candidates kept per pair (ProgressiveSolver::occlusion_of): at most every
+    // polygon for every pair that transfers, within max_cached_candidates, and a map node each.
+    const double pairs = std::min(double(std::max(0, options.max_shots)), n_surfaces) * n_surfaces;
+    const double occluder_lists =
+        options.receiver.shadows.method == ShadowMethod::None
+            ? 0.0
+            : std::min(double(max_cached_candidates), pairs * (polygons / bytes_per_polygon)) *
+                      sizeof(int) +
+                  pairs * 96.0;
     CostEstimate c;
-    c.bytes = program_bytes + fields + hidden + transfers + caches + polygons + textures;
+    c.bytes =
+        program_bytes + fields + hidden + transfers + caches + polygons + textures + occluder_lists;
     c.setup_seconds = options.hidden_regions ? n_surfaces * hidden_seconds_per_surface : 0.0;
     c.seconds = c.setup_seconds + seconds;
     c.detail = "program " + format_bytes(program_bytes) + ", fields " + format_bytes(fields) +
                ", hidden regions " + format_bytes(hidden) + ", transfers " +
                format_bytes(transfers) + ", quadrature caches " + format_bytes(caches) +
-               ", polygons " + format_bytes(polygons) + ", textures " + format_bytes(textures);
+               ", polygons " + format_bytes(polygons) + ", textures " + format_bytes(textures) +
+               ", occluder lists " + format_bytes(occluder_lists);
     return c;
 }
 

@@ -18,6 +18,7 @@
 
 #include <functional>
 #include <iosfwd>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -118,6 +119,10 @@ struct SolveStats {
 /// emission included, or H for a textured reflectance, B = E + rho H; radiosity_view() forms
 /// B either way), what is still unshot (always B), and the union of the receiver quadtrees each
 /// surface was given (leaves).
+/// The most occluder candidates (polygon indices) a solver keeps from one shot to the next,
+/// over all pairs (ProgressiveSolver; 16 MiB; the memory estimate counts it).
+constexpr size_t max_cached_candidates = size_t(1) << 22;
+
 struct Solution {
     std::vector<SplineField> radiosity;
     std::vector<FieldQuantity> quantity;  // per surface; empty means every field holds B
@@ -186,6 +191,13 @@ private:
     mutable std::vector<std::vector<std::vector<double>>> weights_;
     std::vector<HiddenMask> hidden_;    // per surface (empty masks when the option is off)
     std::vector<double> last_seconds_;  // per surface: its last transfer's seconds (scheduling)
+    /// The occluder candidates of a shooter -> receiver pair (make_occlusion_context), kept from
+    /// the pair's first transfer for its later ones: they depend on the two surfaces only.
+    /// Bounded by max_cached_candidates ints in all (beyond, a pair's are found every time).
+    std::map<std::pair<int, int>, std::vector<int>> candidates_;
+    size_t cached_candidates_ = 0;
+    /// The occlusion context of shooter h -> receiver i in shot `shot` (none without shadows).
+    OcclusionContext occlusion_of(int h, int i, int shot) const;
     Rgb power(int surface, const SplineField& field) const;
     /// The unshot increment of an irradiance receiver: the L2 projection of rho dH (eq. (2)).
     SplineField reflected_field(int surface, const SplineField& dH) const;

@@ -538,7 +538,12 @@ IncrementIntegrator::Result IncrementIntegrator::integrate(const SurfacePoint& p
     const double scale = std::max(estimate, 1e-4 * unshot_bound_);
     // Singularity subtraction (QuadratureOptions::subtract): the constant B_h(x*) at the foot
     // x* of p carries the peak of F exactly; the rule integrates F (B_h - B_h(x*)).
-    double near_field = near_field_guard;
+    // DESIGN: no near-field guard where the kernel is bounded (a point on the shooter's own
+    // sphere or cylinder: a self-transfer, or a neighbouring piece of one sphere): the guard
+    // split the cells around such a point down to max_depth for a kernel that is constant there
+    // (inside a sphere, 4.4 times the evaluations for the same values: docs/method.md).
+    const bool bounded = shooter_.surface->bounded_kernel_at(p);
+    double near_field = bounded ? 0 : near_field_guard;
     Rgb exact_part;
     if (planar_ && !unshot_constant_ && options_.subtract && allow_subtraction && !view_.use_rays) {
         const Vec2 uv = plane_.parameters(plane_.to_plane(p.position));
@@ -626,6 +631,7 @@ std::vector<AcceptedCell<Rgb>> IncrementIntegrator::fraction_partition(const Sur
     set_view(p);
     if (view_.behind_all) return out;
     const int n = options_.n;
+    const bool bounded = shooter_.surface->bounded_kernel_at(p);  // no guard: see integrate
     std::vector<QuadCell> todo;
     const int side = 1 << depth;
     for (int j = side - 1; j >= 0; --j)
@@ -638,7 +644,8 @@ std::vector<AcceptedCell<Rgb>> IncrementIntegrator::fraction_partition(const Sur
         const QuadCell cell = todo.back();
         todo.pop_back();
         const size_t n_mixed = mixed_.size();
-        bool split = cell.level < max_fraction_depth && too_near(p, cell, near_field_guard);
+        bool split =
+            cell.level < max_fraction_depth && !bounded && too_near(p, cell, near_field_guard);
         Rgb value;
         if (!split) {
             value = cell_value(p, cell, n);

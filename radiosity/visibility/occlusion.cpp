@@ -156,14 +156,20 @@ bool balls_on_one_side(const std::vector<Ball>& balls, const Plane& pl, double t
 
 }  // namespace
 
-OcclusionContext make_occlusion_context(const Octree& octree, const Surface& shooter,
-                                        int shooter_surface, const Surface& receiver,
-                                        int receiver_surface, std::uint64_t shot) {
+OcclusionContext pair_context(const Octree& octree, int shooter_surface, int receiver_surface,
+                              std::uint64_t shot) {
     OcclusionContext ctx;
     ctx.octree = &octree;
     ctx.shooter_surface = shooter_surface;
     ctx.receiver_surface = receiver_surface;
     ctx.seed = hash_seed(std::uint64_t(shooter_surface), std::uint64_t(receiver_surface), shot);
+    return ctx;
+}
+
+OcclusionContext make_occlusion_context(const Octree& octree, const Surface& shooter,
+                                        int shooter_surface, const Surface& receiver,
+                                        int receiver_surface, std::uint64_t shot) {
+    OcclusionContext ctx = pair_context(octree, shooter_surface, receiver_surface, shot);
 
     std::vector<Vec3> pts = hull_points(shooter);
     for (const Vec3& q : hull_points(receiver)) pts.push_back(q);

@@ -29,6 +29,11 @@ struct OcclusionContext {
 /// corners of its bounding box.
 std::vector<Vec3> hull_points(const Surface& surface);
 
+/// The context of a pair with no candidates yet: its octree, surface ids and seed (`shot`
+/// enters the seed).
+OcclusionContext pair_context(const Octree& octree, int shooter_surface, int receiver_surface,
+                              std::uint64_t shot);
+
 /// The occluders between two surfaces, found with the octree (nodes and polygons outside the
 /// convex hull of both surfaces' hull_points are skipped). `shot` enters the seed.
 OcclusionContext make_occlusion_context(const Octree& octree, const Surface& shooter,
