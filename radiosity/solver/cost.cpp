@@ -140,8 +140,8 @@ CostEstimate scene_cost(const Scene& scene, const SolverOptions& options, int th
     c.detail = "program " + format_bytes(program_bytes) + ", fields " + format_bytes(fields) +
                ", hidden regions " + format_bytes(hidden) + ", transfers " +
                format_bytes(transfers) + ", quadrature caches " + format_bytes(caches) +
-               ", polygons " + format_bytes(polygons) + ", textures " + format_bytes(textures) +
-               ", occluder lists " + format_bytes(occluder_lists);
+               ", occluder lists " + format_bytes(occluder_lists) + ", polygons " +
+               format_bytes(polygons) + ", textures " + format_bytes(textures);
     return c;
 }
 
