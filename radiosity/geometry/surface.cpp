@@ -210,6 +210,17 @@ bool Surface::bounded_kernel_at(const SurfacePoint& p) const {
     return inward_ ? facing <= -1 + 1e-6 : facing >= 1 - 1e-6;
 }
 
+bool Surface::on_same_quadric(const Surface& other) const {
+    if (kind_ != other.kind_ || inward_ != other.inward_) return false;
+    if (kind_ != Kind::Sphere && kind_ != Kind::Cylinder) return false;
+    const double tol = 1e-9 * r1_;
+    if (!(std::fabs(r1_ - other.r1_) <= tol)) return false;
+    const Vec3 d = other.p_[0] - p_[0];
+    if (kind_ == Kind::Sphere) return length(d) <= tol;
+    // One axis line: parallel axes, and the bases' offset along it.
+    return length(cross(e3_, other.e3_)) <= 1e-9 && length(d - dot(d, e3_) * e3_) <= tol;
+}
+
 SurfacePoint Surface::evaluate(double u, double v) const {
     Vec3 x_u, x_v;
     tangents(u, v, x_u, x_v);

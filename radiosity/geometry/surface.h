@@ -69,6 +69,9 @@ public:
     /// R^2) (on a sphere it is that constant on the concave side, zero on the convex one), so
     /// it has no peak near p that a quadrature's nodes could miss. False for other kinds.
     bool bounded_kernel_at(const SurfacePoint& p) const;
+    /// True when both are patches of one whole sphere or cylinder (centre or axis and radius
+    /// within 1e-9 of the radius) facing the same way.
+    bool on_same_quadric(const Surface& other) const;
     /// Total area, the integral of A over [0,1]^2 (closed form where one exists).
     double area() const;
     /// A box containing the whole surface.

@@ -442,9 +442,30 @@ OcclusionContext ProgressiveSolver::occlusion_of(int h, int i, int shot) const {
     if (options_.receiver.shadows.method == ShadowMethod::None)
         return pair_context(octree_, h, i, std::uint64_t(shot));
     const auto it = candidates_.find({h, i});
-    if (it == candidates_.end())
-        return make_occlusion_context(octree_, scene_.surfaces[h].surface, h,
-                                      scene_.surfaces[i].surface, i, std::uint64_t(shot));
+    if (it == candidates_.end()) {
+        const Surface& shooter = scene_.surfaces[h].surface;
+        const Surface& receiver = scene_.surfaces[i].surface;
+        OcclusionContext ctx =
+            make_occlusion_context(octree_, shooter, h, receiver, i, std::uint64_t(shot));
+        // DESIGN: pieces of one concave sphere or cylinder do not occlude each other: a segment
+        // between two of its points lies inside the solid, on the far side of every facet's
+        // chord plane from the thin shell the facet stands for (except within a facet's own
+        // piece, where the segment's end lies and the thickness rule already lets it pass). The
+        // facets of a sphere in 20 pieces were the exact method's candidates along every edge.
+        if (shooter.is_concave() && shooter.on_same_quadric(receiver)) {
+            const std::vector<Polygon>& polys = octree_.polygons();
+            std::vector<int>& c = ctx.candidates;
+            c.erase(std::remove_if(c.begin(), c.end(),
+                                   [&](int id) {
+                                       const int s = polys[size_t(id)].surface();
+                                       return s >= 0 && s < int(scene_.surfaces.size()) &&
+                                              scene_.surfaces[size_t(s)].surface.on_same_quadric(
+                                                  shooter);
+                                   }),
+                    c.end());
+        }
+        return ctx;
+    }
     // DESIGN: the candidates depend on the two surfaces only, the seed on the shot too: the
     // same context as a new search, without the search.
     OcclusionContext ctx = pair_context(octree_, h, i, std::uint64_t(shot));
