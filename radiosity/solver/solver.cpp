@@ -463,13 +463,14 @@ OcclusionContext ProgressiveSolver::occlusion_of(int h, int i, int shot) const {
                                                   shooter);
                                    }),
                     c.end());
+            group_surface_boxes(ctx);
         }
         return ctx;
     }
     // DESIGN: the candidates depend on the two surfaces only, the seed on the shot too: the
     // same context as a new search, without the search.
-    OcclusionContext ctx = pair_context(octree_, h, i, std::uint64_t(shot));
-    ctx.candidates = it->second;
+    OcclusionContext ctx = it->second;
+    ctx.seed = pair_context(octree_, h, i, std::uint64_t(shot)).seed;
     return ctx;
 }
 
@@ -482,13 +483,13 @@ std::vector<ProgressiveSolver::Received> ProgressiveSolver::transfer_to(
     parallel_for(n_rec,
                  [&](int k) { contexts[size_t(k)] = occlusion_of(h, receivers[k], shot_number); });
     for (int k = 0; k < n_rec; ++k) {  // keep new pairs' candidates, within the bound
-        std::vector<int>& c = contexts[size_t(k)].candidates;
+        const std::vector<int>& c = contexts[size_t(k)].candidates;
         if (options_.receiver.shadows.method == ShadowMethod::None ||
             candidates_.count({h, receivers[k]}) ||
             cached_candidates_ + c.size() > max_cached_candidates)
             continue;
         cached_candidates_ += c.size();
-        candidates_[{h, receivers[k]}] = c;
+        candidates_[{h, receivers[k]}] = contexts[size_t(k)];
     }
     auto run_one = [&](int k) {
         const int i = receivers[k];

@@ -194,7 +194,7 @@ private:
     /// The occluder candidates of a shooter -> receiver pair (make_occlusion_context), kept from
     /// the pair's first transfer for its later ones: they depend on the two surfaces only.
     /// Bounded by max_cached_candidates ints in all (beyond, a pair's are found every time).
-    std::map<std::pair<int, int>, std::vector<int>> candidates_;
+    std::map<std::pair<int, int>, OcclusionContext> candidates_;
     size_t cached_candidates_ = 0;
     /// The occlusion context of shooter h -> receiver i in shot `shot` (none without shadows).
     OcclusionContext occlusion_of(int h, int i, int shot) const;

@@ -96,6 +96,42 @@ PatchRays patch_rays(const std::vector<AcceptedCell<Rgb>>& partition, int rays_p
     return out;
 }
 
+/// Whether no box meets the shaft from p to a planar patch with corners q[0..3] (in order
+/// around it): the convex hull of p and the patch, which holds every segment from p to the
+/// patch. Boxes are tested against the four planes through p and an edge, and the patch's own
+/// plane (nothing beyond the shooter blocks). DESIGN: a box within 1e-9 of the coordinates'
+/// size of a plane counts as meeting it; a shaft too thin to orient is never clear.
+bool shaft_clear(Vec3 p, const Vec3 (&q)[4], const std::vector<Box3>& boxes) {
+    const Vec3 centre = 0.25 * (q[0] + q[1] + q[2] + q[3]);
+    double scale = length(p);
+    for (const Vec3& c : q) scale = std::max(scale, length(c));
+    const double tol = 1e-9 * std::max(scale, 1.0);
+    Vec3 normal[5];
+    double offset[5];
+    for (int j = 0; j < 5; ++j) {
+        Vec3 n = j < 4 ? cross(q[j] - p, q[(j + 1) % 4] - p) : cross(q[1] - q[0], q[3] - q[0]);
+        const Vec3 inside = j < 4 ? centre : p;  // a point the half-space keeps
+        const Vec3 on = j < 4 ? p : q[0];
+        const double len = length(n);
+        if (!(len > 0)) return false;
+        n = (1 / len) * n;
+        if (dot(n, inside - on) > 0) n = -1.0 * n;  // inside: dot(n, x) <= offset
+        normal[j] = n;
+        offset[j] = dot(n, on);
+    }
+    for (const Box3& box : boxes) {
+        bool outside = false;
+        for (int j = 0; j < 5 && !outside; ++j) {
+            const Vec3& n = normal[j];
+            const Vec3 nearest{n.x > 0 ? box.lo.x : box.hi.x, n.y > 0 ? box.lo.y : box.hi.y,
+                               n.z > 0 ? box.lo.z : box.hi.z};
+            outside = dot(n, nearest) - offset[j] > tol;
+        }
+        if (!outside) return false;
+    }
+    return true;
+}
+
 /// Eq. (28) at the domain point (s, t), computed (no memo): rays to random points of the
 /// patches of the shooter partition (IncrementIntegrator::fraction_partition), weighed by the
 /// energy each sends to the point.
@@ -136,11 +172,33 @@ Rgb compute_fraction(const ReceiverState& state, IncrementSampler& sampler, Vec2
     const long budget = (1L << (2 * depth)) * n_rays_per_patch;
     const PatchRays rays =
         patch_rays(partition, n_rays_per_patch, budget, hash_seed(point_key, partition.size(), 1));
+    // DESIGN: beyond the paper, a patch whose shaft from p meets no occluder's box is visible
+    // without a ray (r_i = 1 exactly; the others keep their rays and weights, so (28) stays
+    // unbiased). The boxes: the point's own occluders (toward) when it lists them all, else the
+    // pair's, one per occluding surface.
+    std::vector<Box3> boxes;
+    if (plane) {
+        if (toward.size() <= max_listed_occluders) {
+            for (int id : toward) boxes.push_back(ctx.octree->polygons()[size_t(id)].bounds());
+        } else {
+            boxes = ctx.surface_boxes;
+        }
+    }
     Rgb num, den;
     for (size_t i = 0; i < partition.size(); ++i) {
         const AcceptedCell<Rgb>& patch = partition[i];
         const Rgb e = patch.value;  // energy the patch shoots toward p
         if (max_abs(e) == 0) continue;
+        if (plane) {
+            const Rect& c = patch.cell.rect;
+            const Vec3 q[4] = {shooter.point(c.x0, c.y0), shooter.point(c.x1, c.y0),
+                               shooter.point(c.x1, c.y1), shooter.point(c.x0, c.y1)};
+            if (shaft_clear(p.position, q, boxes)) {
+                num += e;
+                den += e;
+                continue;
+            }
+        }
         const int n_patch_rays = rays.count[i];
         if (n_patch_rays == 0) {  // no ray drawn here: counted in sum e_i only (see patch_rays)
             den += e;

@@ -254,7 +254,24 @@ OcclusionContext make_occlusion_context(const Octree& octree, const Surface& sho
         if (!balls.empty() && balls_on_one_side(balls, pl, tol)) continue;
         ctx.candidates.push_back(id);
     }
+    group_surface_boxes(ctx);
     return ctx;
+}
+
+void group_surface_boxes(OcclusionContext& context) {
+    context.surface_boxes.clear();
+    std::vector<int> surfaces;  // surface of each box
+    const std::vector<Polygon>& polys = context.octree->polygons();
+    for (int id : context.candidates) {
+        const Polygon& poly = polys[size_t(id)];
+        const auto it = std::find(surfaces.begin(), surfaces.end(), poly.surface());
+        if (it == surfaces.end()) {
+            surfaces.push_back(poly.surface());
+            context.surface_boxes.push_back(poly.bounds());
+        } else {
+            context.surface_boxes[size_t(it - surfaces.begin())].extend(poly.bounds());
+        }
+    }
 }
 
 bool segment_blocked(const OcclusionContext& context, Vec3 a, Vec3 b, long* n_rays) {

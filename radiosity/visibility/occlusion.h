@@ -20,7 +20,10 @@ struct OcclusionContext {
     int shooter_surface = -1;  // surface ids as the octree's polygons carry them
     int receiver_surface = -1;
     std::vector<int> candidates;  // polygon indices, increasing
-    std::uint64_t seed = 0;       // of every ray of the transfer: the pair and the shot number
+    /// The candidates' bounds, one box per surface they belong to (a shaft that misses every
+    /// box is clear: occluder_boxes, compute_fraction).
+    std::vector<Box3> surface_boxes;
+    std::uint64_t seed = 0;  // of every ray of the transfer: the pair and the shot number
     /// True when nothing can come between the two surfaces.
     bool clear() const { return candidates.empty(); }
 };
@@ -33,6 +36,9 @@ std::vector<Vec3> hull_points(const Surface& surface);
 /// enters the seed).
 OcclusionContext pair_context(const Octree& octree, int shooter_surface, int receiver_surface,
                               std::uint64_t shot);
+
+/// Fills context.surface_boxes from its candidates.
+void group_surface_boxes(OcclusionContext& context);
 
 /// The occluders between two surfaces, found with the octree (nodes and polygons outside the
 /// convex hull of both surfaces' hull_points are skipped). `shot` enters the seed.
