@@ -156,6 +156,12 @@ Rgb compute_fraction(const ReceiverState& state, IncrementSampler& sampler, Vec2
     std::vector<int> toward;
     const ShooterPlane* plane = integrator.shooter_plane();
     if (plane) {
+        // First the pyramid against the pair's boxes, one per occluding surface (shaft_clear):
+        // clear, and the octree is not searched.
+        const Surface& s_h = *sampler.shooter().surface;
+        const Vec3 corners[4] = {s_h.point(0, 0), s_h.point(1, 0), s_h.point(1, 1),
+                                 s_h.point(0, 1)};
+        if (shaft_clear(p.position, corners, ctx.surface_boxes)) return {1, 1, 1};
         // More than max_listed_occluders: the rays go through the octree, so the list need
         // not be complete (the pyramid from a ceiling point to the floor holds the whole room).
         toward = occluders_toward(ctx, *plane, p.position, max_listed_occluders);
