@@ -124,7 +124,8 @@ CostEstimate scene_cost(const Scene& scene, const SolverOptions& options, int th
         std::min(double(std::max(0, options.max_shots)), n_surfaces) * n_surfaces * sizeof(Rgb);
     fields += coupling;
     // The occluder candidates kept per pair (ProgressiveSolver::occlusion_of): at most every
-    // polygon for every pair that transfers, within max_cached_candidates, and a map node each.
+    // polygon for every pair that transfers, within max_cached_candidates ints (their boxes
+    // included), and a map node each.
     const double pairs = std::min(double(std::max(0, options.max_shots)), n_surfaces) * n_surfaces;
     const double occluder_lists =
         options.receiver.shadows.method == ShadowMethod::None

@@ -483,12 +483,13 @@ std::vector<ProgressiveSolver::Received> ProgressiveSolver::transfer_to(
     parallel_for(n_rec,
                  [&](int k) { contexts[size_t(k)] = occlusion_of(h, receivers[k], shot_number); });
     for (int k = 0; k < n_rec; ++k) {  // keep new pairs' candidates, within the bound
-        const std::vector<int>& c = contexts[size_t(k)].candidates;
+        const OcclusionContext& c = contexts[size_t(k)];
+        const size_t size = c.candidates.size() + 12 * c.surface_boxes.size();  // in ints
         if (options_.receiver.shadows.method == ShadowMethod::None ||
             candidates_.count({h, receivers[k]}) ||
-            cached_candidates_ + c.size() > max_cached_candidates)
+            cached_candidates_ + size > max_cached_candidates)
             continue;
-        cached_candidates_ += c.size();
+        cached_candidates_ += size;
         candidates_[{h, receivers[k]}] = contexts[size_t(k)];
     }
     auto run_one = [&](int k) {

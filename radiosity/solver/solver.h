@@ -115,14 +115,14 @@ struct SolveStats {
     std::vector<ShotStats> per_shot;
 };
 
+/// The most occluder candidates (polygon indices, a box counting as 12) a solver keeps from one
+/// shot to the next, over all pairs (ProgressiveSolver; 16 MiB; the memory estimate counts it).
+constexpr size_t max_cached_candidates = size_t(1) << 22;
+
 /// A solved scene: per surface (in scene order) its field, what it holds (quantity: B with the
 /// emission included, or H for a textured reflectance, B = E + rho H; radiosity_view() forms
 /// B either way), what is still unshot (always B), and the union of the receiver quadtrees each
 /// surface was given (leaves).
-/// The most occluder candidates (polygon indices) a solver keeps from one shot to the next,
-/// over all pairs (ProgressiveSolver; 16 MiB; the memory estimate counts it).
-constexpr size_t max_cached_candidates = size_t(1) << 22;
-
 struct Solution {
     std::vector<SplineField> radiosity;
     std::vector<FieldQuantity> quantity;  // per surface; empty means every field holds B

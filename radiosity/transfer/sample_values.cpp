@@ -541,7 +541,7 @@ IncrementIntegrator::Result IncrementIntegrator::integrate(const SurfacePoint& p
     // DESIGN: no near-field guard where the kernel is bounded (a point on the shooter's own
     // sphere or cylinder: a self-transfer, or a neighbouring piece of one sphere): the guard
     // split the cells around such a point down to max_depth for a kernel that is constant there
-    // (inside a sphere, 4.4 times the evaluations for the same values: docs/method.md).
+    // (inside a sphere, 183 times the evaluations for the same values: docs/method.md).
     const bool bounded = shooter_.surface->bounded_kernel_at(p);
     double near_field = bounded ? 0 : near_field_guard;
     Rgb exact_part;

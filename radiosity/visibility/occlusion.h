@@ -21,7 +21,7 @@ struct OcclusionContext {
     int receiver_surface = -1;
     std::vector<int> candidates;  // polygon indices, increasing
     /// The candidates' bounds, one box per surface they belong to (a shaft that misses every
-    /// box is clear: occluder_boxes, compute_fraction).
+    /// box is clear: shaft_clear in compute_fraction).
     std::vector<Box3> surface_boxes;
     std::uint64_t seed = 0;  // of every ray of the transfer: the pair and the shot number
     /// True when nothing can come between the two surfaces.
