@@ -149,9 +149,9 @@ std::vector<OptionSpec> make_option_table() {
                       "two means"),
         choice_option("fraction_rays", &S::fraction_rays, {"kernel", "area"},
                       "paper shadows: how a fraction (28) counts its rays to a shooter patch: "
-                      "each weighted by the kernel (3) at its end (beyond the paper: the visible "
-                      "share of what the patch sends), or each counting one (the paper's: the "
-                      "visible share of its area)"),
+                      "each weighted by the shooter's radiosity times the kernel (3) at its end "
+                      "(beyond the paper: the visible share of what the patch sends), or each "
+                      "counting one (the paper's: the visible share of its area)"),
         choice_option("texture_field", &S::texture_field, {"irradiance", "radiosity"},
                       "what a surface with a textured reflectance stores as its spline field: "
                       "the irradiance H, with B = E + rho H formed at every sample and pixel "
