@@ -300,6 +300,42 @@ TEST_CASE("mbr_tool: a saved solution loads back to the same image; a cut one is
     }
 }
 
+TEST_CASE("mbr_tool: probe saves its solution and says its summary on stderr", "[mbr_tool]") {
+    TempFolder dir;
+    const std::string scene = dir / "lit floor.scene";
+    const std::string points = dir / "points.csv";
+    write_text(scene, lit_floor_scene);
+    write_text(points, "name,x,y,z\nunder,0.25,0,0.6\noutside,0.7,0,0.3\n");
+    // Solved and saved: the summary goes to stderr (stdout holds the CSV alone).
+    const ToolRun saved =
+        run_mbr({"probe", scene, "--points", points, "--save-solution", dir / "p.solution"});
+    CAPTURE(saved);
+    REQUIRE(saved.status == 0);
+    CHECK_THAT(saved.err, Contains("shots "));
+    CHECK_THAT(saved.err, Contains("kernel evaluations"));
+    CHECK_THAT(saved.err, Contains("wrote " + (dir / "p.solution")));
+    CHECK(saved.out.rfind("name,B_r,B_g,B_b\n", 0) == 0);
+    // The same fields as render saves, and loaded back the same values.
+    const ToolRun rendered = run_mbr({"render", scene, "-o", dir / "r.png", "--spp", "1", "--quiet",
+                                      "--save-solution", dir / "r.solution"});
+    REQUIRE(rendered.status == 0);
+    CHECK(read_bytes(dir / "p.solution") == read_bytes(dir / "r.solution"));
+    const ToolRun loaded = run_mbr(
+        {"probe", scene, "--points", points, "--load-solution", dir / "p.solution", "--quiet"});
+    CAPTURE(loaded);
+    REQUIRE(loaded.status == 0);
+    CHECK(loaded.out == saved.out);
+    CHECK(loaded.err.empty());  // --quiet: nothing on stderr
+    // An output that is an input (the points) or two solution options: refused, nothing written.
+    const ToolRun clash = run_mbr({"probe", scene, "--points", points, "--save-solution", points});
+    CHECK(clash.status == 2);
+    CHECK(read_bytes(points) == "name,x,y,z\nunder,0.25,0,0.6\noutside,0.7,0,0.3\n");
+    const ToolRun both = run_mbr({"probe", scene, "--points", points, "--save-solution",
+                                  dir / "x.solution", "--load-solution", dir / "p.solution"});
+    CHECK(both.status == 2);
+    CHECK_FALSE(fs::exists(dir / "x.solution"));
+}
+
 TEST_CASE("mbr_tool: probe prints B at the points in order: E, zero and rho E F", "[mbr_tool]") {
     TempFolder dir;
     const std::string scene = dir / "lit floor.scene";
@@ -322,7 +358,7 @@ TEST_CASE("mbr_tool: probe prints B at the points in order: E, zero and rho E F"
     for (const Point& p : points) csv << p.name << "," << p.x << "," << p.y << "," << p.z << "\n";
     write_text(dir / "points.csv", csv.str());
 
-    const ToolRun run = run_mbr({"probe", scene, "--points", dir / "points.csv"});
+    const ToolRun run = run_mbr({"probe", scene, "--points", dir / "points.csv", "--quiet"});
     CAPTURE(run);
     REQUIRE(run.status == 0);
     CHECK(run.err.empty());
@@ -504,9 +540,9 @@ TEST_CASE("mbr_tool: an output that is one of the inputs is refused, by the file
         CHECK_FALSE(fs::exists(dir / "b.png"));
         // (entries_under names the symbolic link by its target, through fs::relative.)
         CHECK(fs::is_symlink(dir / "link.png"));
-        CHECK(entries_under(dir.path()) ==
-              std::set<std::string>{"lit floor.scene", "a.png", "s.solution", "hard.png",
-                                    "inner.scene", "outer.scene"});
+        CHECK(entries_under(dir.path()) == std::set<std::string>{"lit floor.scene", "a.png",
+                                                                 "s.solution", "hard.png",
+                                                                 "inner.scene", "outer.scene"});
     }
 }
 
@@ -697,8 +733,8 @@ TEST_CASE("mbr_tool: the picture's memory is in the estimate, said before the so
     // is solved or written, where it used to be accepted and run out of memory at the render.
     TempFolder dir;
     std::string scene = lit_floor_scene;
-    const std::string size = "size " + std::to_string(camera_width) + " " +
-                             std::to_string(camera_height);
+    const std::string size =
+        "size " + std::to_string(camera_width) + " " + std::to_string(camera_height);
     const size_t at = scene.find(size);
     REQUIRE(at != std::string::npos);
     scene.replace(at, size.size(), "size 8192 8192");

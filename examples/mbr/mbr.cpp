@@ -103,15 +103,20 @@ std::string render_usage() {
 
 std::string probe_usage() {
     return std::string(
-               "usage: mbr probe SCENE --points FILE.csv [--load-solution F] [options]\n"
+               "usage: mbr probe SCENE --points FILE.csv [--load-solution F | --save-solution F]\n"
+               "                 [options]\n"
                "  Solves SCENE (or loads a solution) and prints the radiosity at each point of\n"
-               "  FILE.csv as CSV: name,B_r,B_g,B_b, one row per point in the file's order.\n"
+               "  FILE.csv as CSV: name,B_r,B_g,B_b, one row per point in the file's order; the\n"
+               "  solve's summary (shots, unshot power, seconds, counts) goes to stderr unless\n"
+               "  --quiet.\n"
                "  --points FILE.csv         header row; columns name, x, y, z required (any\n"
                "                            order), nx, ny, nz optional (picks the surface facing\n"
                "                            that way where several are close), others ignored.\n"
                "                            Each point goes to the nearest surface point within\n"
                "                            1e-3 of the scene's bounding-box diagonal.\n"
-               "  --load-solution F         use F's fields instead of solving\n") +
+               "  --load-solution F         use F's fields instead of solving\n"
+               "  --save-solution F         write the solved fields to F (for render or probe\n"
+               "                            --load-solution)\n") +
            light_group_usage(false) + solver_options_usage();
 }
 
@@ -446,23 +451,42 @@ int render_command(Args& args) {
 int probe_command(Args& args) {
     const std::string points_path = args.text("--points", "");
     const std::string load = args.text("--load-solution", "");
+    const std::string save = args.text("--save-solution", "");
     const GroupArgs group_args = read_group_args(args, false);
     if (points_path.empty()) throw UsageError("--points FILE.csv is required");
-    if (group_args.on() && args.has("--load-solution"))
+    if (!save.empty() && !load.empty())
+        throw UsageError("--save-solution and --load-solution exclude each other");
+    if (group_args.on() && (args.has("--load-solution") || args.has("--save-solution")))
         throw UsageError(
-            "--load-solution holds the whole scene's solution; with light groups use "
-            "--group-solutions");
+            "--save-solution and --load-solution hold the whole scene's solution; with light "
+            "groups use --group-solutions");
+    // As render does: an output that cannot be written, or that is an input, before any work.
+    const std::vector<std::string> outputs{save};
+    refuse_bad_outputs(outputs, {load, points_path});
     SceneRun run = read_scene_run(args, "");
     args.finish();
+    std::vector<std::string> inputs = run_inputs(run, load);
+    inputs.push_back(points_path);
+    refuse_bad_outputs(outputs, inputs);
     const GroupPlan plan = group_args.on() ? plan_groups(group_args, run) : GroupPlan{};
     // Read and place the points before solving: a bad file fails at once.
     const std::vector<ProbePoint> points = read_probe_points(points_path);
     const std::vector<SurfaceLocation> at = locate_probe_points(
         run.scene, run.octree->polygons(), points, points_path, probe_tolerance(run.scene));
-    std::ostringstream ignored;
+    // The summary goes to stderr (stdout is the CSV), unless --quiet.
+    const bool report = !run.quiet;
+    std::ostringstream summary;
     std::vector<OutputFile> none;  // probe saves no group solutions
-    const Solution solution = group_args.on() ? relight(run, plan, false, ignored, none)
-                                              : obtain_solution(run, load, false, ignored);
+    const Solution solution = group_args.on() ? relight(run, plan, report, summary, none)
+                                              : obtain_solution(run, load, report, summary);
+    if (!save.empty()) {
+        std::ostringstream os;
+        save_solution(os, run.scene, solution);
+        MBR_CHECK_MSG(!os.fail(), "the solution of " << save << " could not be formatted");
+        write_files({{save, os.str()}});  // a temporary name, then renamed
+        if (report) summary << "wrote " << save << "\n";
+    }
+    std::cerr << summary.str();
     // Relit: B is formed with the groups' emissions times their weights (see render_command).
     const Scene lit =
         group_args.on() ? weighted_scene(run.scene, plan.groups, plan.weights) : Scene{};
