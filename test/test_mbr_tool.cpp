@@ -723,7 +723,32 @@ TEST_CASE("mbr_tool: messages name an unknown option, a 0/0 unshot share and ran
     const ToolRun run = run_mbr({"render", dir / "dark.scene", "-o", out, "--spp", "1"});
     CAPTURE(run);
     CHECK(run.status == 0);
-    CHECK_THAT(run.out, Contains("unshot power left 0 % of emitted"));
+    CHECK_THAT(run.out, Contains(" 0 % of the power unshot in total"));
+}
+
+TEST_CASE("mbr_tool: the summary says why the solve stopped, and the total left unshot",
+          "[mbr_tool]") {
+    TempFolder dir;
+    const std::string scene = dir / "lit floor.scene";
+    write_text(scene, lit_floor_scene);
+    auto summary = [&](const std::vector<std::string>& more) {
+        std::vector<std::string> args = {"render", scene, "-o", dir / "x.png", "--spp", "1"};
+        args.insert(args.end(), more.begin(), more.end());
+        const ToolRun run = run_mbr(args);
+        CAPTURE(run);
+        REQUIRE(run.status == 0);
+        return run.out;
+    };
+    // One shot of the light: the floor's reflected power is still unshot, above the threshold.
+    const std::string limited = summary({"--max-shots", "1"});
+    CHECK_THAT(limited, Contains("shots 1, stopped at the shot limit, "));
+    CHECK_THAT(limited, Contains(" % of the power unshot in total (ambient correction applied)"));
+    const std::string converged = summary({"--convergence", "0.5"});
+    CHECK_THAT(converged,
+               Contains(", stopped: largest unshot share below the convergence threshold, "));
+    CHECK_THAT(summary({"--max-shots", "1", "--ambient", "off"}),
+               Contains("(no ambient correction)"));
+    CHECK_THAT(limited, !Contains("converged"));
 }
 
 TEST_CASE("mbr_tool: the picture's memory is in the estimate, said before the solve",

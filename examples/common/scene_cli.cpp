@@ -123,9 +123,8 @@ void finish_scene_run(const SolverArgs& a, SceneRun& run) {
     if (!near.empty()) {
         const NearContact& c = near.front();
         std::ostringstream os;
-        os << "warning: " << run.path << ": '" << run.scene.surfaces[size_t(c.b)].name
-           << "' lies " << c.gap << " in front of the plane of '"
-           << run.scene.surfaces[size_t(c.a)].name
+        os << "warning: " << run.path << ": '" << run.scene.surfaces[size_t(c.b)].name << "' lies "
+           << c.gap << " in front of the plane of '" << run.scene.surfaces[size_t(c.a)].name
            << "', within the solver's plane tolerance: it is taken as lying on it, and no light "
               "passes between them";
         if (near.size() > 1) os << " (and " << near.size() - 1 << " more such pairs)";
@@ -216,8 +215,9 @@ public:
         std::string bar(filled, '#');
         bar += std::string(width - filled, '.');
         char line[200];
-        std::snprintf(line, sizeof line, "[%s] shot %d/%d, unshot %.3g%%, %.1f s, about %.0f s left",
-                      bar.c_str(), shot.shot, max_shots, 100 * left, elapsed, rest);
+        std::snprintf(line, sizeof line,
+                      "[%s] shot %d/%d, unshot %.3g%%, %.1f s, about %.0f s left", bar.c_str(),
+                      shot.shot, max_shots, 100 * left, elapsed, rest);
         show(line, false);
     }
 
@@ -299,9 +299,11 @@ void write_summary_csv(std::ostream& os, const SolveStats& st) {
 void print_summary(std::ostream& os, const SceneRun& run, const SolveStats& st) {
     os << run.path << ": " << run.scene.surfaces.size() << " surfaces, "
        << run.octree->polygon_count() << " polygons\n"
-       << "shots " << st.shots << (st.converged ? " (converged)" : " (shot limit)")
-       << ", unshot power left " << cell_g(percent_of_emitted(st.unshot_power, st), 4)
-       << " % of emitted\n"
+       << "shots " << st.shots
+       << (st.converged ? ", stopped: largest unshot share below the convergence threshold, "
+                        : ", stopped at the shot limit, ")
+       << cell_g(percent_of_emitted(st.unshot_power, st), 4) << " % of the power unshot in total ("
+       << (run.options.ambient ? "ambient correction applied" : "no ambient correction") << ")\n"
        << "seconds " << cell(st.seconds, 3) << " (" << thread_count() << " threads), peak memory "
        << cell(double(st.peak_memory_bytes) / (1024.0 * 1024.0), 1) << " MiB, coefficients "
        << st.coefficients << " per channel\n"
@@ -313,7 +315,8 @@ double write_render(const SceneRun& run, const Solution& solution, const std::st
     if (!run.scene.has_camera)
         throw InputError(run.path, 0, "the scene has no camera statement: nothing to render from");
     const double start = now_seconds();
-    const Image radiance = render_radiance(run.scene, *run.octree, radiosity_view(run.scene, solution), options);
+    const Image radiance =
+        render_radiance(run.scene, *run.octree, radiosity_view(run.scene, solution), options);
     write_files({{path, encode_png(tone_map(radiance, options.exposure))}});
     return now_seconds() - start;
 }

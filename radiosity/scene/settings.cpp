@@ -105,8 +105,8 @@ std::vector<OptionSpec> make_option_table() {
                                     "cap on progressive-refinement shots"),
                      {"--shots"}),
         real_option("convergence", &S::convergence, 0, 1, false, true, "c",
-                    "stop when the largest unshot power is below this fraction of the emitted "
-                    "power"),
+                    "stop when the largest unshot power of one surface is below this fraction "
+                    "of the emitted power (the total unshot, reported at the end, is larger)"),
         switch_option("self_transfer", &S::self_transfer,
                       "a surface that can see itself (an inward cylinder or sphere patch) receives "
                       "from itself; planar surfaces never do"),
