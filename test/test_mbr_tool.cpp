@@ -300,6 +300,44 @@ TEST_CASE("mbr_tool: a saved solution loads back to the same image; a cut one is
     }
 }
 
+TEST_CASE("mbr_tool: render without a camera frames the scene; camera options replace it",
+          "[mbr_tool]") {
+    TempFolder dir;
+    std::string no_camera = lit_floor_scene;
+    no_camera.erase(no_camera.find("camera eye"));
+    write_text(dir / "bare.scene", no_camera);
+    auto render = [&](const std::string& out, const std::vector<std::string>& more) {
+        std::vector<std::string> args = {"render", dir / "bare.scene", "-o", out, "--spp", "1"};
+        args.insert(args.end(), more.begin(), more.end());
+        return run_mbr(args);
+    };
+    auto png_size = [](const std::string& path) {
+        int w = 0, h = 0, n = 0;
+        REQUIRE(stbi_info(path.c_str(), &w, &h, &n));
+        return std::pair<int, int>(w, h);
+    };
+    const ToolRun framed = render(dir / "framed.png", {"--quiet"});
+    CAPTURE(framed);
+    REQUIRE(framed.status == 0);
+    CHECK(png_size(dir / "framed.png") == std::pair<int, int>(640, 480));
+    const ToolRun given =
+        render(dir / "given.png", {"--camera", "0.5", "0.35", "-1", "0.5", "0.15", "0.6", "0", "1",
+                                   "0", "--fov", "60", "--size", "32", "24", "--quiet"});
+    CAPTURE(given);
+    REQUIRE(given.status == 0);
+    CHECK(png_size(dir / "given.png") == std::pair<int, int>(32, 24));
+    for (const std::vector<std::string>& bad :
+         {std::vector<std::string>{"--back-faces", "grey"},
+          {"--fov", "180"},
+          {"--size", "0", "10"},
+          {"--camera", "1", "1", "1", "1", "1", "1", "0", "1", "0"}}) {
+        const ToolRun run = render(dir / "bad.png", bad);
+        CAPTURE(run);
+        CHECK(run.status == 2);
+        CHECK_FALSE(fs::exists(dir / "bad.png"));
+    }
+}
+
 TEST_CASE("mbr_tool: probe saves its solution and says its summary on stderr", "[mbr_tool]") {
     TempFolder dir;
     const std::string scene = dir / "lit floor.scene";
@@ -698,8 +736,11 @@ TEST_CASE("mbr_tool: messages name an unknown option, a 0/0 unshot share and ran
     const Case cases[] = {
         {"a single-dash unknown option", {"render", scene, "-o", out, "-x"}, "unknown option -x"},
         {"an unknown option with values",
+         {"render", scene, "-o", out, "--lens", "0", "1", "3"},
+         "unknown option --lens"},
+        {"--camera with too few numbers",
          {"render", scene, "-o", out, "--camera", "0", "1", "3"},
-         "unknown option --camera"},
+         "--camera needs 9 numbers, got 3"},
         {"--shots beyond its range",
          {"render", scene, "-o", out, "--shots", "10000001"},
          "--shots"},

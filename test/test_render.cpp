@@ -223,6 +223,71 @@ TEST_CASE("render: the back of a one-sided surface and a miss are black", "[rend
     }
 }
 
+TEST_CASE("render: a surface's back is culled by default, black on request", "[render]") {
+    // quad_scene's quad (z = 0, facing the camera at z = 1) behind a second quad at z = 0.5
+    // that faces away from the camera and covers the whole view.
+    Scene scene = quad_scene();
+    const double a = 2 * quad_half;
+    scene.surfaces.push_back(
+        {"back", Surface::planar_quad({-a, -a, 0.5}, {-a, a, 0.5}, {a, a, 0.5}, {a, -a, 0.5}), 0});
+    const std::vector<SplineField> B = {SplineField::constant(3, 1, {1, 1, 1}),
+                                        SplineField::constant(3, 1, {5, 5, 5})};
+    const Octree octree = build_octree(scene);
+    RenderOptions black;
+    black.back_faces = BackFaces::Black;
+    RenderStats s_black, s_cull;
+    const Image dark = render_radiance(scene, octree, B, black, &s_black);
+    const Image seen = render_radiance(scene, octree, B, {}, &s_cull);
+    CHECK(n_not_black(dark) == 0);
+    CHECK(s_black.n_back_hits == s_black.n_camera_rays);
+    // Culled: every ray goes on through the back and meets the far quad's front, B / pi = 1/pi.
+    CHECK(s_cull.n_back_hits == s_cull.n_camera_rays);
+    CHECK(s_cull.n_front_hits == s_cull.n_camera_rays);
+    for (const Rgb& px : seen.pixels) CHECK(px.r == Approx(1 / Pi));
+}
+
+TEST_CASE("render: the framing camera sees a whole box from its open side", "[render]") {
+    // A box [0, 2] x [0, 1] x [0, 3] of five inward faces, open at z = 0 (the Cornell box's
+    // shape): the camera stands on the open side and every corner of the bounds is in view.
+    std::istringstream in(
+        "material white reflectance 0.5 0.5 0.5\n"
+        "rectangle floor   white 0 0 0  0 0 3  2 0 0\n"
+        "rectangle ceiling white 0 1 0  2 0 0  0 0 3\n"
+        "rectangle back    white 0 0 3  0 1 0  2 0 0\n"
+        "rectangle left    white 0 0 0  0 1 0  0 0 3\n"
+        "rectangle right   white 2 0 0  0 0 3  0 1 0\n");
+    const Scene scene = parse_scene(in, "open.scene");
+    REQUIRE_FALSE(scene.has_camera);
+    const Camera c = framing_camera(scene);
+    CHECK(c.eye.z < 0);  // the open side
+    CHECK(c.width == 640);
+    CHECK(c.height == 480);
+    const Vec3 f = normalize(c.look_at - c.eye);
+    const Vec3 right = normalize(cross(f, c.up)), up = cross(right, f);
+    const double half_h = std::tan(0.5 * c.fov_degrees * Pi / 180),
+                 half_w = half_h * c.width / c.height;
+    const Box3 box = scene.bounds();
+    for (int k = 0; k < 8; ++k) {
+        const Vec3 corner{k & 1 ? box.hi.x : box.lo.x, k & 2 ? box.hi.y : box.lo.y,
+                          k & 4 ? box.hi.z : box.lo.z};
+        const Vec3 d = corner - c.eye;
+        CAPTURE(k);
+        REQUIRE(dot(d, f) > 0);
+        CHECK(std::abs(dot(d, right) / dot(d, f)) < half_w);
+        CHECK(std::abs(dot(d, up) / dot(d, f)) < half_h);
+    }
+    // Rendered from there with the default culling, the box's inside fills the middle.
+    Scene shown = scene;
+    shown.camera = c;
+    shown.has_camera = true;
+    std::vector<SplineField> B(scene.surfaces.size(), SplineField::constant(3, 0, {1, 1, 1}));
+    RenderOptions o;
+    o.samples_per_pixel = 1;
+    const Image image = render_radiance(shown, build_octree(shown), B, o);
+    const Rgb& middle = image.pixels[size_t(image.height / 2) * image.width + image.width / 2];
+    CHECK(middle.r == Approx(1 / Pi));
+}
+
 TEST_CASE("render: a varying field is seen at the hit's (u, v)", "[render]") {
     const Scene scene = quad_scene();
     const Octree octree = build_octree(scene);

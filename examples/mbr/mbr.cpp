@@ -89,7 +89,9 @@ std::string render_usage() {
     return std::string(
                "usage: mbr render SCENE -o OUT.png [options]\n"
                "  Solves SCENE by progressive refinement (or loads a solution) and renders it\n"
-               "  with its camera: radiance B/pi at each pixel, sRGB tone mapping.\n"
+               "  with its camera: radiance B/pi at each pixel, sRGB tone mapping. Without a\n"
+               "  camera statement (an OBJ file), a camera that frames the scene's bounds\n"
+               "  (docs/scene-format.md, \"camera\").\n"
                "  -o OUT.png                the image (required)\n"
                "  --spp n                   samples per pixel, 1..4096 (default 4)\n"
                "  --exposure x              radiance multiplier before tone mapping (default 1)\n"
@@ -97,7 +99,14 @@ std::string render_usage() {
                "  --quadtree                draw each surface's final quadtree over the image\n"
                "  --save-solution F         write the solved fields to F\n"
                "  --load-solution F         render F's fields instead of solving\n"
-               "  --seed n                  seed of the pixel jitter (default 1)\n") +
+               "  --seed n                  seed of the pixel jitter (default 1)\n"
+               "  --camera EX EY EZ LX LY LZ UX UY UZ\n"
+               "                            the camera's eye, look_at point and up direction\n"
+               "                            (replacing the scene's or the framing camera's)\n"
+               "  --fov F                   vertical field of view, degrees in (0, 180)\n"
+               "  --size W H                image size in pixels, 1..16384 each\n"
+               "  --back-faces cull|black   a ray meeting a surface's back sees what lies\n"
+               "                            beyond (default) or black\n") +
            light_group_usage(true) + solver_options_usage();
 }
 
@@ -367,6 +376,47 @@ Solution relight(SceneRun& run, const GroupPlan& plan, bool report, std::ostream
     return sum;
 }
 
+/// The camera options of render, as given (empty vectors when absent).
+struct CameraArgs {
+    std::vector<double> view;  // --camera: eye, look_at, up (9 numbers)
+    double fov = 0;            // --fov (0: absent)
+    std::vector<double> size;  // --size W H
+};
+
+CameraArgs read_camera_args(Args& args) {
+    CameraArgs c;
+    c.view = args.numbers("--camera", 9);
+    c.fov = args.number("--fov", 0);
+    if (args.has("--fov") && !(c.fov > 0 && c.fov < 180))
+        throw UsageError("--fov must be in (0, 180) degrees");
+    c.size = args.numbers("--size", 2);
+    for (double v : c.size)
+        if (!(v >= 1 && v <= 16384 && v == std::floor(v)))
+            throw UsageError("--size takes two integers in 1..16384");
+    return c;
+}
+
+/// The scene's camera, or the framing camera when it has none (framing_camera), with the
+/// options' changes; UsageError when the result cannot look anywhere.
+Camera chosen_camera(const Scene& scene, const CameraArgs& c) {
+    Camera cam = scene.has_camera ? scene.camera : framing_camera(scene);
+    if (!c.view.empty()) {
+        cam.eye = {c.view[0], c.view[1], c.view[2]};
+        cam.look_at = {c.view[3], c.view[4], c.view[5]};
+        cam.up = {c.view[6], c.view[7], c.view[8]};
+        const Vec3 dir = cam.look_at - cam.eye;
+        if (!(length(dir) > 0)) throw UsageError("--camera: eye and look_at coincide");
+        if (!(length(cam.up) > 0) || length(cross(normalize(dir), normalize(cam.up))) < 1e-6)
+            throw UsageError("--camera: up is zero or parallel to the viewing direction");
+    }
+    if (c.fov > 0) cam.fov_degrees = c.fov;
+    if (!c.size.empty()) {
+        cam.width = int(c.size[0]);
+        cam.height = int(c.size[1]);
+    }
+    return cam;
+}
+
 int render_command(Args& args) {
     const std::string out = args.text("-o", "");
     const int spp = args.integer("--spp", 4, 1, 4096);
@@ -376,6 +426,11 @@ int render_command(Args& args) {
     const std::string save = args.text("--save-solution", "");
     const std::string load = args.text("--load-solution", "");
     const int seed = args.integer("--seed", 1, 0, 2147483647);
+    const CameraArgs camera_args = read_camera_args(args);
+    const std::string faces = args.text("--back-faces", "cull");
+    if (faces != "cull" && faces != "black")
+        throw UsageError("--back-faces must be cull or black (got '" + faces + "')");
+    const BackFaces back_faces = faces == "cull" ? BackFaces::Cull : BackFaces::Black;
     const GroupArgs group_args = read_group_args(args, true);
     if (out.empty()) throw UsageError("-o OUT.png is required");
     if (!save.empty() && !load.empty())
@@ -399,9 +454,10 @@ int render_command(Args& args) {
         inputs.insert(inputs.end(), plan.load.begin(), plan.load.end());
     }
     refuse_bad_outputs(outputs, inputs);
-    if (!run.scene.has_camera)
-        throw InputError(run.path, 0, "the scene has no camera statement: nothing to render from");
+    run.scene.camera = chosen_camera(run.scene, camera_args);
+    run.scene.has_camera = true;
     RenderOptions ro;
+    ro.back_faces = back_faces;
     ro.samples_per_pixel = spp;
     ro.seed = static_cast<std::uint64_t>(seed);
     ro.exposure = exposure;
@@ -431,7 +487,8 @@ int render_command(Args& args) {
     const Image radiance = render_radiance(shown, *run.octree, radiosity_view(shown, solution), ro);
     Image display = tone_map(radiance, exposure);
     if (quadtree)
-        draw_quadtree_overlay(display, shown, *run.octree, &solution.leaves, ro.overlay_colour);
+        draw_quadtree_overlay(display, shown, *run.octree, &solution.leaves, ro.overlay_colour,
+                              nullptr, back_faces);
     files.push_back({out, encode_png(display)});
     if (!hdr.empty()) {
         std::ostringstream os;

@@ -85,23 +85,36 @@ struct FrontHit {
     double u = 0, v = 0;
 };
 
-std::optional<FrontHit> front_hit(const Octree& octree, const Ray& ray, RenderStats* stats) {
+/// A culled ray goes on through at most this many backs (a closed object seen from inside
+/// another: two backs per wall of a room of boxes seen from outside).
+constexpr int max_culled_backs = 64;
+
+std::optional<FrontHit> front_hit(const Octree& octree, const Ray& ray, RenderStats* stats,
+                                  BackFaces back_faces) {
     RayStats* ray_stats = stats ? &stats->rays : nullptr;
     if (stats) ++stats->n_camera_rays;
-    const std::optional<Hit> hit = octree.closest_hit(ray, ray_stats);
-    if (!hit) return std::nullopt;
-    // DESIGN: the side is decided by the normal of the polygon the ray met rather than by
-    // Surface::normal at the hit's (u, v). Both agree on the front (facets are counter-clockwise
-    // seen from it), but only the facet's normal matches the geometry the ray actually hit: near
-    // the silhouette of a tessellated sphere or cylinder the true normal at (u, v) can already
-    // face away while the facet still faces the camera, which would leave a ring of black pixels.
-    if (dot(ray.dir, octree.polygons()[hit->polygon].normal()) >= 0) {
+    Ray r = ray;
+    for (int backs = 0; backs <= max_culled_backs; ++backs) {
+        const std::optional<Hit> hit = octree.closest_hit(r, ray_stats);
+        if (!hit) return std::nullopt;
+        // DESIGN: the side is decided by the normal of the polygon the ray met rather than by
+        // Surface::normal at the hit's (u, v). Both agree on the front (facets are
+        // counter-clockwise seen from it), but only the facet's normal matches the geometry the
+        // ray actually hit: near the silhouette of a tessellated sphere or cylinder the true
+        // normal at (u, v) can already face away while the facet still faces the camera, which
+        // would leave a ring of black pixels.
+        if (dot(r.dir, octree.polygons()[hit->polygon].normal()) < 0) {
+            if (stats) ++stats->n_front_hits;
+            // Polygon::uv_at extrapolates slightly beyond a facet's edge (the octree's slack).
+            return FrontHit{hit->surface, std::clamp(hit->uv.x, 0.0, 1.0),
+                            std::clamp(hit->uv.y, 0.0, 1.0)};
+        }
         if (stats) ++stats->n_back_hits;
-        return std::nullopt;
+        if (back_faces == BackFaces::Black) return std::nullopt;
+        // DESIGN: culled, the ray goes on from just beyond the back (1e-9 of its distance).
+        r.t_min = hit->t + 1e-9 * std::max(hit->t, 1e-300);
     }
-    if (stats) ++stats->n_front_hits;
-    // Polygon::uv_at extrapolates slightly beyond a facet's edge (the octree's edge slack).
-    return FrontHit{hit->surface, std::clamp(hit->uv.x, 0.0, 1.0), std::clamp(hit->uv.y, 0.0, 1.0)};
+    return std::nullopt;
 }
 
 Rgb radiance_at(const RadiosityView& radiosity, const std::optional<FrontHit>& hit) {
@@ -310,14 +323,49 @@ RenderStats& RenderStats::operator+=(const RenderStats& other) {
     return *this;
 }
 
+Camera framing_camera(const Scene& scene) {
+    Camera c;
+    c.fov_degrees = 45;
+    c.width = 640;
+    c.height = 480;
+    c.up = {0, 1, 0};
+    const Box3 bounds = scene.bounds();
+    const Vec3 centre = bounds.empty() ? Vec3{0, 0, 0} : bounds.centre();
+    const double r = bounds.empty() ? 0 : 0.5 * length(bounds.extent());
+    const double radius = r > 0 ? r : 1;  // a point or nothing: a unit sphere around it
+    const double distance = 1.05 * radius / std::sin(0.5 * c.fov_degrees * Pi / 180);
+    // The four sides, each a horizontal axis raised by 0.15 (from straight ahead both side
+    // walls of a box face the eye; a little above, its floor shows).
+    const Vec3 sides[4] = {{0, 0.15, 1}, {0, 0.15, -1}, {1, 0.15, 0}, {-1, 0.15, 0}};
+    Vec3 best = normalize(sides[0]);
+    double best_facing = -HUGE_VAL;
+    for (const Vec3& side : sides) {
+        const Vec3 d = normalize(side);
+        double facing = 0;
+        for (const SceneSurface& s : scene.surfaces)
+            for (int a = 0; a < 4; ++a)
+                for (int b = 0; b < 4; ++b) {
+                    const SurfacePoint p = s.surface.evaluate((a + 0.5) / 4, (b + 0.5) / 4);
+                    facing += p.area_factor / 16 * dot(p.normal, d);
+                }
+        if (facing > best_facing) {
+            best_facing = facing;
+            best = d;
+        }
+    }
+    c.look_at = centre;
+    c.eye = centre + distance * best;
+    return c;
+}
+
 Ray camera_ray(const Camera& camera, double x, double y) {
     return CameraFrame(camera).ray(x, y);
 }
 
 Rgb radiance_along(const Scene& scene, const Octree& octree, const RadiosityView& radiosity,
-                   const Ray& ray, RenderStats* stats) {
+                   const Ray& ray, RenderStats* stats, BackFaces back_faces) {
     check_fields(scene, radiosity);
-    return radiance_at(radiosity, front_hit(octree, ray, stats));
+    return radiance_at(radiosity, front_hit(octree, ray, stats, back_faces));
 }
 
 double render_bytes(int width, int height, const RenderOptions& options) {
@@ -355,7 +403,8 @@ Image render_radiance(const Scene& scene, const Octree& octree, const RadiosityV
                     j_y = (s / k + j_y) / k;
                 }
                 const Ray ray = camera.ray(x + j_x, y + j_y);
-                sum += radiance_at(radiosity, front_hit(octree, ray, &row_stats[y]));
+                sum += radiance_at(radiosity,
+                                   front_hit(octree, ray, &row_stats[y], options.back_faces));
             }
             image.at(x, y) = (1.0 / spp) * sum;
         }
@@ -383,7 +432,7 @@ Image tone_map(const Image& radiance, double exposure) {
 
 void draw_quadtree_overlay(Image& display, const Scene& scene, const Octree& octree,
                            const std::vector<std::vector<DyadicCell>>* leaves, Rgb colour,
-                           RenderStats* stats) {
+                           RenderStats* stats, BackFaces back_faces) {
     const CameraFrame camera(scene.camera);
     const int width = scene.camera.width, height = scene.camera.height;
     MBR_CHECK(display.width == width && display.height == height);
@@ -405,7 +454,7 @@ void draw_quadtree_overlay(Image& display, const Scene& scene, const Octree& oct
     parallel_for(height, [&](int y) {
         for (int x = 0; x < width; ++x) {
             const std::optional<FrontHit> hit =
-                front_hit(octree, camera.ray(x + 0.5, y + 0.5), &row_stats[y]);
+                front_hit(octree, camera.ray(x + 0.5, y + 0.5), &row_stats[y], back_faces);
             if (hit)
                 seen[size_t(y) * width + x] = {hit->surface,
                                                lookup[hit->surface].find(hit->u, hit->v)};

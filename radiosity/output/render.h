@@ -21,6 +21,11 @@
 namespace mbr {
 
 /// Options of the renderer.
+/// What a camera ray that meets the back of a surface sees (surfaces are one-sided): black, or
+/// what lies beyond (the back face culled, as viewers of the classic radiosity scenes do: their
+/// cameras stand outside the room, behind a wall).
+enum class BackFaces { Black, Cull };
+
 struct RenderOptions {
     int samples_per_pixel = 4;                // jittered camera rays per pixel (>= 1); stratified
                                               // on a k x k grid when a square k^2
@@ -28,6 +33,7 @@ struct RenderOptions {
     double exposure = 1;                      // multiplier on radiance before tone mapping
     bool quadtree_overlay = false;            // draw the quadtree leaves' boundaries (teaching)
     Rgb overlay_colour = {0.08, 0.08, 0.08};  // their line colour, a display value in [0, 1]
+    BackFaces back_faces = BackFaces::Cull;   // a camera ray meeting a surface's back
 };
 
 /// Work done by a render.
@@ -45,6 +51,17 @@ struct RenderStats {
 /// stb's PNG encoding, and with the quadtree overlay the surface and leaf seen at each pixel.
 double render_bytes(int width, int height, const RenderOptions& options = {});
 
+/// The camera a scene without a camera statement is rendered from (docs/scene-format.md,
+/// "camera"): it looks at the centre c of the scene's bounds from one of four sides (+z, -z, +x,
+/// -x, each direction d raised by 0.15), the side the scene's
+/// surfaces face most on balance (the sum of area x n . d over a 4 x 4 grid of each surface: a
+/// box open on one side is seen through its opening; a closed room ties, and ties go to the
+/// first), up (0, 1, 0), a vertical field of view of 45 degrees and 640 x 480 pixels,
+/// from the distance at which the bounds' sphere (radius r, half the diagonal) fits the field
+/// of view with 5 % to spare: 1.05 r / sin(22.5 degrees). With back faces culled (the default)
+/// the walls between it and the inside of a room are not drawn.
+Camera framing_camera(const Scene& scene);
+
 /// The pinhole ray of scene-format.md through image point (x, y) in pixels, (0, 0) the top left
 /// corner of the image and (width, height) the bottom right; the image's right is
 /// (look_at - eye) x up. The direction is not normalised (t counts distances to the image plane).
@@ -55,7 +72,8 @@ Ray camera_ray(const Camera& camera, double x, double y);
 /// clamped to [0,1]^2; zero for a miss, for the back of a surface and
 /// for an empty field. Adds its counts to *stats if given.
 Rgb radiance_along(const Scene& scene, const Octree& octree, const RadiosityView& radiosity,
-                   const Ray& ray, RenderStats* stats = nullptr);
+                   const Ray& ray, RenderStats* stats = nullptr,
+                   BackFaces back_faces = BackFaces::Black);
 
 /// The linear radiance image of scene.camera: per pixel the plain average (box filter) of
 /// options.samples_per_pixel radiance_along() samples jittered inside the pixel. radiosity gives
@@ -79,7 +97,7 @@ Image tone_map(const Image& radiance, double exposure);
 /// only the surfaces' outlines are drawn. Adds its camera rays to *stats if given.
 void draw_quadtree_overlay(Image& display, const Scene& scene, const Octree& octree,
                            const std::vector<std::vector<DyadicCell>>* leaves, Rgb colour,
-                           RenderStats* stats = nullptr);
+                           RenderStats* stats = nullptr, BackFaces back_faces = BackFaces::Cull);
 
 /// The whole display pipeline: render_radiance, tone_map with options.exposure, and, when
 /// options.quadtree_overlay is on, draw_quadtree_overlay with `leaves`.
