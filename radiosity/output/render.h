@@ -40,7 +40,7 @@ struct RenderOptions {
 struct RenderStats {
     long n_camera_rays = 0;  // rays cast (samples, plus one per pixel for the overlay)
     long n_front_hits = 0;   // rays that met the front of a surface
-    long n_back_hits = 0;    // rays that met the back of a surface (zero radiance)
+    long n_back_hits = 0;    // backs of surfaces met (culled: passed; black: zero radiance)
     RayStats rays;           // octree work of those rays
     /// Adds another part's counts.
     RenderStats& operator+=(const RenderStats& other);
