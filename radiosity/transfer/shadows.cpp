@@ -150,6 +150,7 @@ Rgb compute_fraction(const ReceiverState& state, IncrementSampler& sampler, Vec2
     const Vec2 at = receiver.hidden ? receiver.hidden->substitute(s, t) : Vec2{s, t};
     const SurfacePoint p = receiver.surface->evaluate(at.x, at.y);
     IncrementIntegrator& integrator = sampler.integrator(thread);
+    const Surface& shooter = *sampler.shooter().surface;
     // DESIGN: beyond the paper, the rays of a point are tested only against the occluders that
     // meet its pyramid to a planar shooter; when there are none the fraction is 1 without a ray
     // (what the rays would give, to the bit) and without the partition's kernel evaluations.
@@ -158,9 +159,8 @@ Rgb compute_fraction(const ReceiverState& state, IncrementSampler& sampler, Vec2
     if (plane) {
         // First the pyramid against the pair's boxes, one per occluding surface (shaft_clear):
         // clear, and the octree is not searched.
-        const Surface& s_h = *sampler.shooter().surface;
-        const Vec3 corners[4] = {s_h.point(0, 0), s_h.point(1, 0), s_h.point(1, 1),
-                                 s_h.point(0, 1)};
+        const Vec3 corners[4] = {shooter.point(0, 0), shooter.point(1, 0), shooter.point(1, 1),
+                                 shooter.point(0, 1)};
         if (shaft_clear(p.position, corners, ctx.surface_boxes)) return {1, 1, 1};
         // More than max_listed_occluders: the rays go through the octree, so the list need
         // not be complete (the pyramid from a ceiling point to the floor holds the whole room).
@@ -171,7 +171,6 @@ Rgb compute_fraction(const ReceiverState& state, IncrementSampler& sampler, Vec2
     const std::vector<AcceptedCell<Rgb>> partition =
         integrator.fraction_partition(p, depth, n_evals);
     const int n_rays_per_patch = state.options.shadows.rays_per_patch;
-    const Surface& shooter = *sampler.shooter().surface;
     // DESIGN: the rays of a point are seeded from its position (a fulcrum's (level, k, l) in
     // lowest terms: two fulcrums at one point share the fraction), the pair and the shot.
     const std::uint64_t point_key = hash_seed(ctx.seed, bits(point.x), bits(point.y));
