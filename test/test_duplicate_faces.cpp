@@ -229,7 +229,8 @@ TEST_CASE("duplicate faces: one warning for many repeats, naming the first", "[d
                Contains("dup.obj:6: ") && Contains("dup.obj:5") && Contains("(and 998 more"));
 }
 
-TEST_CASE("duplicate faces: an OBJ repeat with another material is an error", "[duplicate_faces]") {
+TEST_CASE("duplicate faces: an OBJ repeat with another material is an error when strict",
+          "[duplicate_faces]") {
     mbr::test::TempFolder dir;
     dir.write("m.mtl", "newmtl white\nKd 0.5 0.5 0.5\nnewmtl red\nKd 0.6 0.1 0.1\n");
     const std::string obj = dir.write("m.obj",
@@ -237,11 +238,19 @@ TEST_CASE("duplicate faces: an OBJ repeat with another material is an error", "[
                                       "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
                                       "usemtl white\nf 1 2 3 4\n"
                                       "usemtl red\nf 2 3 4 1\n");
-    const InputError e = error_of([&] { load_obj(obj); });
+    const InputError e = error_of([&] { load_obj(obj, ImportOptions{true}); });
     CHECK(e.file() == obj);
     CHECK(e.line() == 9);
     CHECK_THAT(e.message(),
                Contains(obj + ":7") && Contains("'red' here") && Contains("'white' there"));
+    // Forgiving (the default): the first kept, the repeat dropped, with a warning of its own.
+    const Scene s = load_obj(obj);
+    CHECK(s.surfaces.size() == 1);
+    CHECK(s.material_of(0).name == "white");
+    REQUIRE(s.warnings.size() == 1);
+    CHECK(s.warnings[0].kind == "duplicate surface with another material");
+    CHECK(s.warnings[0].line == 9);
+    CHECK_THAT(s.warnings[0].message, Contains("the first is kept and the repeat dropped"));
 }
 
 TEST_CASE("duplicate faces: an OBJ face that repeats a scene surface", "[duplicate_faces]") {
@@ -260,10 +269,13 @@ TEST_CASE("duplicate faces: an OBJ face that repeats a scene surface", "[duplica
         CHECK(s.warnings[0].line == 5);
         CHECK_THAT(s.warnings[0].message, Contains(scene + ":2"));
     }
-    SECTION("another material: an error at the OBJ's line") {
+    SECTION("another material: an error at the OBJ's line when strict, else dropped") {
         const std::string scene = dir.write(
             "t.scene", materials + "quad floor red  0 0 0  1 0 0  1 1 0  0 1 0\nobj part.obj\n");
-        const InputError e = error_of([&] { load_scene(scene); });
+        const Scene s = load_scene(scene);
+        CHECK(s.surfaces.size() == 1);
+        CHECK(s.surfaces[0].name == "floor");
+        const InputError e = error_of([&] { load_scene(scene, ImportOptions{true}); });
         CHECK(e.file() == obj);
         CHECK(e.line() == 5);
         CHECK_THAT(e.message(), Contains(scene + ":3") && Contains("'obj_default' here") &&

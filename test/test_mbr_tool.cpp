@@ -820,3 +820,88 @@ TEST_CASE("mbr_tool: the picture's memory is in the estimate, said before the so
     CAPTURE(small);
     CHECK(small.status == 0);
 }
+
+TEST_CASE("mbr_tool: an OBJ with defects and no camera renders as it is meant; --strict refuses",
+          "[mbr_tool][obj]") {
+    TempFolder dir;
+    // A closed box room (walls facing in), a lamp 1 cm below the ceiling wound facing up, a
+    // material with Kd 1 and a stray statement in the MTL, a zero-area face; the extension in
+    // capitals.
+    write_text(dir / "room.mtl",
+               "newmtl wall\nKd 0.6 0.6 0.6\nv 1 2 3\nnewmtl lamp\nKe 3 3 3\n"
+               "newmtl white\nKd 1 1 1\n");
+    const std::string obj = dir / "ROOM.OBJ";
+    write_text(obj,
+               "mtllib room.mtl\nusemtl wall\n"
+               "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n"
+               "f 1 5 6 2\nf 4 3 7 8\nf 1 2 3 4\nf 5 8 7 6\nf 1 4 8 5\nf 2 6 7 3\n"
+               "usemtl white\nf 1 2 2\n"
+               "usemtl lamp\nv 0.4 0.99 0.4\nv 0.6 0.99 0.4\nv 0.6 0.99 0.6\nv 0.4 0.99 0.6\n"
+               "f 9 12 11 10\n");
+    const std::string png = dir / "room.png";
+    ToolRun run =
+        run_mbr({"render", obj, "-o", png, "--spp", "1", "--size", "48", "36", "--max-shots", "8"});
+    CAPTURE(run);
+    REQUIRE(run.status == 0);
+    CHECK_THAT(run.err, Contains("ROOM.OBJ:24: light 'ROOM.6' faced a surface 0.01 away"));
+    CHECK_THAT(run.err, Contains("unknown MTL statement 'v'; the statement is skipped"));
+    CHECK_THAT(run.err, Contains("Kd 1 is outside [0, 1)"));
+    CHECK_THAT(run.err, Contains("degenerate face"));
+    // The floor is lit: a probe below the lamp sees the lamp's light.
+    write_text(dir / "p.csv", "name,x,y,z\nfloor,0.5,0,0.5\n");
+    ToolRun probe =
+        run_mbr({"probe", obj, "--points", dir / "p.csv", "--max-shots", "8", "--quiet"});
+    CAPTURE(probe);
+    REQUIRE(probe.status == 0);
+    const std::vector<std::string> rows = split(probe.out, '\n');
+    REQUIRE(rows.size() == 2);
+    CHECK(std::stod(split(rows[1], ',')[1]) > 0.1);
+    // Strict: the first fault, at its file and line, and no picture.
+    fs::remove(png);
+    run = run_mbr({"render", obj, "-o", png, "--strict"});
+    CHECK(run.status == 2);
+    CHECK_THAT(run.err, Contains("room.mtl:3: unknown MTL statement 'v'"));
+    CHECK(!fs::exists(png));
+}
+
+TEST_CASE("mbr_tool: --light lights a file without Ke; --two-sided-lights makes back faces",
+          "[mbr_tool][obj]") {
+    TempFolder dir;
+    write_text(dir / "m.mtl", "newmtl floor\nKd 0.5 0.5 0.5\nnewmtl panel\nKd 0.5 0.5 0.5\n");
+    const std::string obj = dir / "dark.obj";
+    write_text(obj,
+               "mtllib m.mtl\no floor\nusemtl floor\nv 0 0 0\nv 0 0 1\nv 1 0 1\nv 1 0 0\n"
+               "f 1 2 3 4\no panel\nusemtl panel\n"
+               "v 0.3 0.5 0.3\nv 0.7 0.5 0.3\nv 0.7 0.5 0.7\nv 0.3 0.5 0.7\nf 5 6 7 8\n");
+    write_text(dir / "p.csv", "name,x,y,z\nfloor,0.5,0,0.5\n");
+    auto floor_value = [&](const std::vector<std::string>& more, std::string* err = nullptr) {
+        std::vector<std::string> args = {"probe", obj, "--points", dir / "p.csv", "--quiet"};
+        args.insert(args.end(), more.begin(), more.end());
+        const ToolRun run = run_mbr(args);
+        CAPTURE(run);
+        REQUIRE(run.status == 0);
+        if (err) *err = run.err;
+        return std::stod(split(split(run.out, '\n')[1], ',')[1]);
+    };
+    std::string err;
+    CHECK(floor_value({}, &err) == 0);
+    CHECK_THAT(err, Contains("nothing in the scene emits light"));
+    CHECK_THAT(err, Contains("--light NAME"));
+    // The panel as a light with E = 10 (by material), facing down onto the floor.
+    const double lit = floor_value({"--light", "panel=10"}, &err);
+    CHECK_THAT(err, Contains("--light panel: 1 surface (material) emit E = 10"));
+    CHECK(lit > 0.5);
+    // Without E: the default emission, said.
+    CHECK(floor_value({"--light", "panel"}, &err) > 0);
+    CHECK_THAT(err, Contains("--light panel: 1 surface (material) emit E = "));
+    // Facing up (wound the other way), the panel lights the floor only when two-sided.
+    write_text(obj,
+               "mtllib m.mtl\no floor\nusemtl floor\nv 0 0 0\nv 0 0 1\nv 1 0 1\nv 1 0 0\n"
+               "f 1 2 3 4\no panel\nusemtl panel\n"
+               "v 0.3 0.5 0.3\nv 0.7 0.5 0.3\nv 0.7 0.5 0.7\nv 0.3 0.5 0.7\nf 8 7 6 5\n");
+    CHECK(floor_value({"--light", "panel=10"}) == 0);
+    CHECK(floor_value({"--light", "panel=10", "--two-sided-lights"}) == Approx(lit).epsilon(0.01));
+    const ToolRun bad = run_mbr({"probe", obj, "--points", dir / "p.csv", "--light", "nothing"});
+    CHECK(bad.status == 2);
+    CHECK_THAT(bad.err, Contains("has no material and no surface of that name"));
+}

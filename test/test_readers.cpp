@@ -120,7 +120,7 @@ TEST_CASE("readers: a folder, a device or a FIFO is refused by every reader, by 
             CHECK_THAT(e.message(), Contains("'" + path + "': " + problem));
         }
         const std::string obj = dir.write("m.obj", "mtllib " + path + "\n");
-        InputError e = error_of([&] { load_obj(obj); });
+        InputError e = error_of([&] { load_obj(obj, ImportOptions{true}); });
         CHECK(e.message() == "material library '" + path + "': " + problem);
     }
 }
@@ -255,7 +255,7 @@ TEST_CASE("readers: one emission limit for the scene format and MTL; probe coord
     dir.write("m.mtl", "newmtl hot\nKe 1e30 0 0\n");
     const std::string obj =
         dir.write("m.obj", "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
-    InputError e = error_of([&] { load_obj(obj); });
+    InputError e = error_of([&] { load_obj(obj, ImportOptions{true}); });
     CHECK(e.line() == 2);
     CHECK(e.message() ==
           "Ke 1e+30 exceeds the limit 3.183098861837907e+29 (the emission E = pi Ke is at most "

@@ -141,17 +141,21 @@ TEST_CASE("scene_fuzz: mutated scene files give a Scene or an InputError", "[sce
 
 TEST_CASE("scene_fuzz: mutated OBJ files give a Scene or an InputError", "[scene_fuzz][obj]") {
     std::vector<std::string> seeds = {obj_sample, read_bytes(scenes_dir + "cornell_box.obj")};
-    int n_accepted = 0, n_refused = 0;
-    fuzz(
-        seeds, 3000, 77,
-        [](const std::string& text) {
-            std::istringstream in(text);
-            return parse_obj(in, scenes_dir + "fuzz.obj");
-        },
-        n_accepted, n_refused);
-    CAPTURE(n_accepted, n_refused);
+    // Strictly read, and forgiving: the same mutations (the same seed), which the forgiving
+    // import must accept more often, never crashing.
+    int n_accepted = 0, n_refused = 0, n_forgiven = 0, n_refused_forgiving = 0;
+    for (const bool strict : {true, false})
+        fuzz(
+            seeds, 3000, 77,
+            [strict](const std::string& text) {
+                std::istringstream in(text);
+                return parse_obj(in, scenes_dir + "fuzz.obj", ImportOptions{strict});
+            },
+            strict ? n_accepted : n_forgiven, strict ? n_refused : n_refused_forgiving);
+    CAPTURE(n_accepted, n_refused, n_forgiven, n_refused_forgiving);
     CHECK(n_accepted > 300);
     CHECK(n_refused > 1000);
+    CHECK(n_forgiven > n_accepted + 500);
 }
 
 TEST_CASE("scene_fuzz: mutated MTL files give a Scene or an InputError", "[scene_fuzz][obj]") {
@@ -176,9 +180,20 @@ TEST_CASE("scene_fuzz: mutated MTL files give a Scene or an InputError", "[scene
         {mtl_seed}, 800, 99,
         [&](const std::string& text) {
             std::ofstream((dir / "m.mtl").string(), std::ios::binary | std::ios::trunc) << text;
-            return load_obj(obj_path);
+            return load_obj(obj_path, ImportOptions{true});
         },
         n_accepted, n_refused);
+    // Forgiving, every mutation of the library gives a scene (the faces are always there).
+    int n_forgiven = 0, n_refused_forgiving = 0;
+    fuzz(
+        {mtl_seed}, 800, 99,
+        [&](const std::string& text) {
+            std::ofstream((dir / "m.mtl").string(), std::ios::binary | std::ios::trunc) << text;
+            return load_obj(obj_path);
+        },
+        n_forgiven, n_refused_forgiving);
+    CAPTURE(n_forgiven, n_refused_forgiving);
+    CHECK(n_refused_forgiving == 0);
     std::error_code ec;
     std::filesystem::remove_all(dir, ec);
     CAPTURE(n_accepted, n_refused);

@@ -35,6 +35,12 @@ Scene parse_obj_text(const std::string& text) {
     return parse_obj(in, obj_name);
 }
 
+/// OBJ text read strictly (ImportOptions::strict): every fault refused.
+Scene parse_obj_strict(const std::string& text) {
+    std::istringstream in(text);
+    return parse_obj(in, obj_name, ImportOptions{true});
+}
+
 /// The InputError that parsing `text` throws (fails the test when there is none).
 template <class Parse>
 InputError error_of(Parse parse, const std::string& text) {
@@ -57,7 +63,7 @@ void check_error(const std::string& text, int line, const std::string& part) {
 }
 
 void check_obj_error(const std::string& text, int line, const std::string& part) {
-    InputError e = error_of(parse_obj_text, text);
+    InputError e = error_of(parse_obj_strict, text);
     CAPTURE(text, e.what());
     CHECK(e.line() == line);
     CHECK_THAT(e.message(), Contains(part));
@@ -671,7 +677,8 @@ TEST_CASE("scene_io: OBJ and MTL errors", "[scene_io][obj][errors]") {
     auto obj_error = [&](const std::string& mtl, const std::string& obj) {
         dir.write("e.mtl", mtl);
         std::string path = dir.write("e.obj", obj);
-        return error_of([](const std::string& p) { return load_obj(p); }, path);
+        return error_of([](const std::string& p) { return load_obj(p, ImportOptions{true}); },
+                        path);
     };
     // A missing material library.
     InputError e = obj_error("", quad + "mtllib nothere.mtl\nf 1 2 3 4\n");

@@ -29,11 +29,6 @@ const char* reference_usage =
 
 namespace {
 
-bool ends_with(const std::string& s, const std::string& suffix) {
-    return s.size() >= suffix.size() &&
-           s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
-}
-
 std::uint64_t parse_seed(const std::string& text) {
     char* end = nullptr;
     errno = 0;
@@ -67,8 +62,7 @@ int reference_command(Args& args) {
     options.threads = threads;
 
     const std::string& scene_path = positional[0];
-    const Scene scene =
-        ends_with(scene_path, ".obj") ? load_obj(scene_path) : load_scene(scene_path);
+    const Scene scene = is_obj_path(scene_path) ? load_obj(scene_path) : load_scene(scene_path);
     print_scene_warnings(std::cerr, scene);
     const std::vector<ProbePoint> points = read_probe_points(points_path);
     const Octree octree = build_octree(scene);

@@ -2,8 +2,6 @@
 // whole-scene programs.
 #include "examples/common/scene_cli.h"
 
-#include <unistd.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -14,6 +12,7 @@
 #include "math/parallel.h"
 #include "radiosity/output/image.h"
 #include "radiosity/output/output_file.h"
+#include "radiosity/scene/light_sides.h"
 #include "radiosity/scene/scene_io.h"
 #include "radiosity/scene/scene_octree.h"
 #include "radiosity/solver/cost.h"
@@ -26,7 +25,16 @@
 namespace mbr {
 
 std::string solver_options_usage() {
-    return "  SCENE                     a scene file (docs/scene-format.md)\n" + option_usage() +
+    return "  SCENE                     a scene file (docs/scene-format.md) or a Wavefront OBJ\n"
+           "                            file (.obj in any case, with its MTL libraries)\n" +
+           option_usage() +
+           "  --strict                  refuse every fault of an imported OBJ, MTL or texture\n"
+           "                            (default: repair it where the intent is clear, warn)\n"
+           "  --light NAME[=E]          make material NAME, or the surfaces NAME and NAME.K,\n"
+           "                            emit E (one number, or R,G,B; default: a mean radiosity\n"
+           "                            of about 1 in the scene): for files without Ke\n"
+           "  --two-sided-lights        every light emits from both sides (as the material\n"
+           "                            clause two_sided makes it)\n"
            "  --threads n               OpenMP threads, 1..256 (default: all cores)\n"
            "  --quiet                   no progress bar\n"
            "  --memory-budget X         refuse a run estimated to need more memory (bytes, or\n"
@@ -56,6 +64,9 @@ struct SolverArgs {
     };
     std::vector<Given> given;
     double memory_budget = 0;
+    ImportOptions import;
+    std::string light;  // --light NAME[=E], or empty
+    bool two_sided_lights = false;
     /// True when the line gives the option called `name`.
     bool has(const std::string& name) const {
         for (const Given& g : given)
@@ -78,8 +89,132 @@ SolverArgs read_solver_args(Args& args, SceneRun& run) {
     for (const SolverArgs::Given& g : a.given) apply_flag(check, g.option, g.flag, g.value);
     run.threads = args.integer("--threads", 0, 1, 256);
     run.quiet = args.flag("--quiet");
+    run.progress = std::make_shared<ProgressReporter>(!run.quiet);
     a.memory_budget = read_memory_budget(args);
+    a.import.strict = args.flag("--strict");
+    a.light = args.text("--light", "");
+    a.two_sided_lights = args.flag("--two-sided-lights");
+    if (args.has("--light") && a.light.empty())
+        throw UsageError("--light needs a material or surface name (--light NAME[=E])");
     return a;
+}
+
+/// The emission of --light NAME=E: one number (grey) or R,G,B, each finite, >= 0 and at most
+/// the scene format's limit, not all zero.
+Rgb light_emission(const std::string& text) {
+    std::vector<std::string> parts(1);
+    for (char c : text) {
+        if (c == ',')
+            parts.emplace_back();
+        else
+            parts.back() += c;
+    }
+    if (parts.size() != 1 && parts.size() != 3)
+        throw UsageError("--light NAME=E: E is one number or R,G,B, found '" + text + "'");
+    Rgb e;
+    for (int i = 0; i < 3; ++i) {
+        const double x = parse_number(parts[parts.size() == 1 ? 0 : size_t(i)], "--light's E");
+        if (!(x >= 0 && x <= max_emission))
+            throw UsageError("--light NAME=E: E must lie in [0, " + detail::fmt(max_emission) +
+                             "], found " + detail::fmt(x));
+        e[i] = x;
+    }
+    if (max_abs(e) == 0) throw UsageError("--light NAME=E: E is zero, which lights nothing");
+    return e;
+}
+
+/// --light NAME[=E] (docs/scene-format.md, "Lights for files without them"): the surfaces of
+/// material NAME (and of its copies for texture coordinates, NAME@LINE.K), or else the surfaces
+/// called NAME or NAME.K, emit E. Without E, the lights get the emission that gives an
+/// enclosure of the scene's area and mean reflectance rho a mean radiosity of 1: E = A (1 - rho)
+/// / A_lights. Says on stderr what it did.
+void apply_light(Scene& scene, const std::string& value, const std::string& path) {
+    const size_t eq = value.find('=');
+    const std::string name = value.substr(0, eq);
+    if (name.empty()) throw UsageError("--light needs a material or surface name before '='");
+    std::vector<int> lit;  // the surfaces that will emit
+    const auto family = [](const std::string& m) { return m.substr(0, m.rfind('@')); };
+    for (size_t i = 0; i < scene.surfaces.size(); ++i)
+        if (family(scene.material_of(int(i)).name) == name) lit.push_back(int(i));
+    const bool by_material = !lit.empty();
+    if (!by_material)
+        for (size_t i = 0; i < scene.surfaces.size(); ++i) {
+            const std::string& s = scene.surfaces[i].name;
+            if (s == name ||
+                (s.size() > name.size() && s.compare(0, name.size(), name) == 0 &&
+                 s[name.size()] == '.' &&
+                 s.find_first_not_of("0123456789", name.size() + 1) == std::string::npos))
+                lit.push_back(int(i));
+        }
+    if (lit.empty())
+        throw UsageError("--light " + name + ": " + path +
+                         " has no material and no surface of that name");
+    double area = 0, lit_area = 0, rho_area = 0;
+    for (size_t i = 0; i < scene.surfaces.size(); ++i) {
+        const double a = scene.surfaces[i].surface.area();
+        area += a;
+        rho_area += a * max_abs(scene.material_of(int(i)).reflectance.mean());
+    }
+    for (int i : lit) lit_area += scene.surfaces[size_t(i)].surface.area();
+    Rgb e;
+    if (eq != std::string::npos) {
+        e = light_emission(value.substr(eq + 1));
+    } else {
+        const double rho = area > 0 ? rho_area / area : 0;
+        const double x = lit_area > 0 ? std::min(area * (1 - rho) / lit_area, max_emission) : 1.0;
+        e = {x, x, x};
+    }
+    // Each lit surface's material, copied once with the emission (a material is shared by
+    // surfaces that do not all emit when the light is named by surface).
+    std::vector<int> copy(scene.materials.size(), -1);
+    for (int i : lit) {
+        int& m = copy[size_t(scene.surfaces[size_t(i)].material)];
+        if (m < 0) {
+            Material light = scene.materials[size_t(scene.surfaces[size_t(i)].material)];
+            if (!by_material) light.name += ":light";
+            light.emission = Texture::constant(e);
+            if (by_material) {
+                m = scene.surfaces[size_t(i)].material;
+                scene.materials[size_t(m)] = std::move(light);
+            } else {
+                scene.materials.push_back(std::move(light));
+                m = int(scene.materials.size()) - 1;
+            }
+        }
+        scene.surfaces[size_t(i)].material = m;
+    }
+    std::cerr << "--light " << name << ": " << lit.size()
+              << (lit.size() == 1 ? " surface" : " surfaces") << " ("
+              << (by_material ? "material" : "surface name")
+              << ") emit E = " << detail::fmt_approx(e.r)
+              << (e.r == e.g && e.g == e.b
+                      ? std::string()
+                      : " " + detail::fmt_approx(e.g) + " " + detail::fmt_approx(e.b))
+              << "\n";
+}
+
+/// Loads the scene or OBJ file at `path` (an OBJ by its extension in any case), applies
+/// --light, and warns when nothing in it emits.
+Scene load_any_scene(const std::string& path, const SolverArgs& a) {
+    Scene scene = is_obj_path(path) ? load_obj(path, a.import) : load_scene(path, a.import);
+    if (!a.light.empty()) apply_light(scene, a.light, path);
+    if (a.two_sided_lights) {
+        std::vector<int> lights;
+        for (size_t m = 0; m < scene.materials.size(); ++m)
+            if (scene.materials[m].emits() && !scene.materials[m].two_sided)
+                lights.push_back(int(m));
+        add_back_sides(scene, lights);
+    }
+    if (scene.emitters().empty()) {
+        SceneWarning w;
+        w.kind = "no light";
+        w.file = path;
+        w.message =
+            "nothing in the scene emits light (no emission, no Ke), so every picture is "
+            "black; name a light with --light NAME (a material or surface name)";
+        scene.warn(w);
+    }
+    return scene;
 }
 
 /// "room.scene (27 surfaces, max depth 6, tessellation 24)": a run for messages.
@@ -130,7 +265,10 @@ void finish_scene_run(const SolverArgs& a, SceneRun& run) {
         if (near.size() > 1) os << " (and " << near.size() - 1 << " more such pairs)";
         std::cerr << os.str() << "\n";
     }
+    run.progress->stage("building the octree of " + std::to_string(run.scene.surfaces.size()) +
+                        " surfaces");
     run.octree = std::make_unique<Octree>(build_octree(run.scene));
+    run.progress->stage("");
 }
 
 }  // namespace
@@ -160,8 +298,8 @@ SceneRun read_scene_run(Args& args, const std::string& default_scene) {
         throw UsageError("one scene file, please (got " + std::to_string(pos.size()) + ")");
     if (pos.empty() && default_scene.empty()) throw UsageError("a scene file is required");
     run.path = pos.empty() ? default_scene : pos[0];
-    const bool obj = run.path.size() > 4 && run.path.compare(run.path.size() - 4, 4, ".obj") == 0;
-    run.scene = obj ? load_obj(run.path) : load_scene(run.path);
+    run.progress->stage("reading " + run.path);
+    run.scene = load_any_scene(run.path, a);
     finish_scene_run(a, run);
     return run;
 }
@@ -173,77 +311,34 @@ SceneRun read_scene_run(Args& args, Scene scene, const std::string& name) {
     if (!pos.empty()) throw UsageError("unexpected argument '" + pos[0] + "'");
     run.path = name;
     run.scene = std::move(scene);
+    if (!a.light.empty()) apply_light(run.scene, a.light, name);
     finish_scene_run(a, run);
     return run;
 }
 
 namespace {
 
-/// Progress on stderr: on a terminal a line redrawn in place, elsewhere (a pipe, a log file) a
-/// line every `interval` seconds, the first after that long, so that short runs stay silent.
-class ProgressBar {
-public:
-    explicit ProgressBar(bool on) : on_(on), terminal_(isatty(2)), start_(now_seconds()) {}
-    ~ProgressBar() {
-        if (drawn_) std::fprintf(stderr, "\r%*s\r", 100, "");
+/// The shots' progress (ProgressReporter::update): the unshot share so far and, from its fall
+/// over the shots so far, an estimate of the time left to the target; the receivers of the shot
+/// under way when `done` and `total` are given.
+struct ShotProgress {
+    int shot = 0, max_shots = 0;
+    double left = 1;     // unshot share after the last shot
+    double target = 0;   // the convergence threshold
+    double elapsed = 0;  // seconds of the shots so far
+    double fraction() const {
+        return std::clamp(left > 0 && target > 0 ? std::log(left) / std::log(target) : 1.0, 0.0,
+                          1.0);
     }
-    /// The hidden regions before the first shot: `done` of `total` surfaces.
-    void setup(int done, int total) {
-        const double elapsed = now_seconds() - start_;
-        const double rest = done > 0 ? elapsed * (total - done) / done : 0;
-        char line[160];
-        std::snprintf(line, sizeof line,
-                      "hidden regions: %d/%d surfaces, %.1f s, about %.0f s left", done, total,
-                      elapsed, rest);
-        show(line, done == total);
-    }
-    void update(const ShotStats& shot, const ProgressiveSolver& solver, int max_shots,
-                double target) {
-        const SolveStats& st = solver.solution().stats;
-        double elapsed = 0;
-        for (const ShotStats& x : st.per_shot) elapsed += x.seconds;
-        const double left = st.emitted_power > 0 ? shot.unshot_after / st.emitted_power : 0;
-        // Estimate of the rest: the unshot power has fallen from 1 to `left` in `elapsed`;
-        // assume it keeps falling geometrically to the target (or the shot limit).
-        double rest = 0;
+    /// Assumes the unshot power keeps falling geometrically to the target, and no more shots
+    /// than the limit at the mean time a shot has taken.
+    double seconds_left() const {
+        if (shot < 1) return -1;
+        double rest = (max_shots - shot) * elapsed / shot;
         if (left > target && left < 1 && target > 0)
-            rest = elapsed * std::log(left / target) / std::log(1 / left);
-        const int width = 24;
-        const double done =
-            std::clamp(left > 0 && target > 0 ? std::log(left) / std::log(target) : 1.0, 0.0, 1.0);
-        const int filled = static_cast<int>(done * width);
-        std::string bar(filled, '#');
-        bar += std::string(width - filled, '.');
-        char line[200];
-        std::snprintf(line, sizeof line,
-                      "[%s] shot %d/%d, unshot %.3g%%, %.1f s, about %.0f s left", bar.c_str(),
-                      shot.shot, max_shots, 100 * left, elapsed, rest);
-        show(line, false);
+            rest = std::min(rest, elapsed * std::log(left / target) / std::log(1 / left));
+        return rest;
     }
-
-private:
-    static constexpr double interval = 5;  // seconds between lines off a terminal
-    void show(const char* line, bool last) {
-        if (!on_) return;
-        if (terminal_) {
-            std::fprintf(stderr, "\r%s   ", line);
-            drawn_ = true;
-        } else {
-            // Off a terminal: every `interval` seconds, and the end of a stage that was shown.
-            const double t = now_seconds() - start_;
-            if (t < next_ && !(last && shown_)) return;
-            std::fprintf(stderr, "%s\n", line);
-            shown_ = true;
-            next_ = t + interval;
-        }
-        std::fflush(stderr);
-    }
-    bool on_ = false;
-    bool terminal_ = false;
-    bool drawn_ = false;  // a line is on the terminal, to be cleared at the end
-    bool shown_ = false;  // off a terminal, some line has been printed
-    double start_ = 0;
-    double next_ = interval;
 };
 
 }  // namespace
@@ -252,13 +347,46 @@ Solution solve_scene(SceneRun& run, bool progress) {
     // A receiver too coarse for a light's peak is an error before the first shot, not a dark
     // picture after it (radiosity/solver/resolution.h).
     check_resolution(run.scene, run.options.receiver.max_depth);
-    ProgressBar bar(progress && !run.quiet);
-    return solve(
+    ProgressReporter* reporter = progress && run.progress ? run.progress.get() : nullptr;
+    ShotProgress sp;
+    sp.max_shots = run.options.max_shots;
+    sp.target = run.options.convergence;
+    char text[160];
+    bool in_shot = false;  // the stage shown is a shot's (else the solver's setup)
+    if (reporter) reporter->stage("setting up the solver");
+    const auto shot_stage = [&] {
+        in_shot = true;
+        std::snprintf(text, sizeof text, "shot %d/%d, unshot %.3g%%", sp.shot + 1, sp.max_shots,
+                      100 * sp.left);
+        reporter->stage(text);
+        reporter->update("", sp.fraction(), sp.seconds_left());
+    };
+    Solution solution = solve(
         run.scene, *run.octree, run.options,
         [&](const ShotStats& shot, const ProgressiveSolver& solver) {
-            bar.update(shot, solver, run.options.max_shots, run.options.convergence);
+            if (!reporter) return;
+            const SolveStats& st = solver.solution().stats;
+            sp.shot = shot.shot;
+            sp.elapsed = 0;
+            for (const ShotStats& x : st.per_shot) sp.elapsed += x.seconds;
+            sp.left = st.emitted_power > 0 ? shot.unshot_after / st.emitted_power : 0;
+            shot_stage();
         },
-        [&](int done, int total) { bar.setup(done, total); });
+        [&](int done, int total) {
+            if (!reporter) return;
+            if (done == 1) reporter->stage("hidden regions");
+            std::snprintf(text, sizeof text, "%d/%d surfaces", done, total);
+            reporter->update(text, double(done) / total);
+            if (done == total) shot_stage();
+        },
+        [&](int done, int total) {
+            if (!reporter) return;
+            if (!in_shot) shot_stage();
+            std::snprintf(text, sizeof text, "%d/%d receivers", done, total);
+            reporter->update(text, sp.fraction(), sp.seconds_left());
+        });
+    if (reporter) reporter->stage("");
+    return solution;
 }
 
 namespace {
@@ -312,11 +440,21 @@ void print_summary(std::ostream& os, const SceneRun& run, const SolveStats& st) 
 
 double write_render(const SceneRun& run, const Solution& solution, const std::string& path,
                     const RenderOptions& options) {
-    if (!run.scene.has_camera)
-        throw InputError(run.path, 0, "the scene has no camera statement: nothing to render from");
+    // Without a camera statement, the camera that frames the scene (framing_camera).
+    Scene framed;
+    if (!run.scene.has_camera) {
+        framed = run.scene;
+        framed.camera = framing_camera(run.scene);
+        framed.has_camera = true;
+    }
+    const Scene& shown = run.scene.has_camera ? run.scene : framed;
     const double start = now_seconds();
+    if (run.progress)
+        run.progress->stage("rendering " + std::to_string(shown.camera.width) + " x " +
+                            std::to_string(shown.camera.height));
     const Image radiance =
-        render_radiance(run.scene, *run.octree, radiosity_view(run.scene, solution), options);
+        render_radiance(shown, *run.octree, radiosity_view(run.scene, solution), options);
+    if (run.progress) run.progress->stage("");
     write_files({{path, encode_png(tone_map(radiance, options.exposure))}});
     return now_seconds() - start;
 }

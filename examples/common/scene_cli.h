@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "examples/common/cli.h"
+#include "examples/common/progress.h"
 #include "octree/octree.h"
 #include "radiosity/output/render.h"
 #include "radiosity/scene/scene.h"
@@ -31,6 +32,8 @@ struct SceneRun {
     std::unique_ptr<Octree> octree;  // over scene_polygons(scene, settings.tessellation)
     CostEstimate cost;               // the solve's estimate (radiosity/solver/cost.h)
     double memory_budget = 0;        // --memory-budget (bytes)
+    /// The run's progress on stderr (off with --quiet): reading, the octree, the solve.
+    std::shared_ptr<ProgressReporter> progress;
 };
 
 /// Says the cost of the solve and of a picture of the scene's camera together before either is
@@ -55,7 +58,8 @@ SceneRun read_scene_run(Args& args, const std::string& default_scene);
 /// warnings printed; `name` stands for the path in summaries.
 SceneRun read_scene_run(Args& args, Scene scene, const std::string& name);
 
-/// Solves, with a progress bar on stderr when it is a terminal and `progress` is set.
+/// Solves, with its progress on stderr (run.progress) when `progress` is set: the hidden
+/// regions, each shot and the receivers inside it.
 Solution solve_scene(SceneRun& run, bool progress);
 
 /// One line per shot.
@@ -67,10 +71,10 @@ std::vector<std::string> summary_cells(const SolveStats& stats);
 /// The run's summary as one CSV table: header shots,unshot_percent,seconds,peak_mib,coefficients.
 void write_summary_csv(std::ostream& os, const SolveStats& stats);
 
-/// Renders the solution with the scene's camera (radiance B / pi, sRGB tone mapping with
-/// options.exposure) and writes it as a PNG to `path` (all or nothing,
-/// radiosity/output/output_file.h). InputError when the scene has no camera. Returns the render's
-/// seconds.
+/// Renders the solution with the scene's camera, or without one the camera that frames the
+/// scene (framing_camera, radiosity/output/render.h), as radiance B / pi with sRGB tone mapping
+/// and options.exposure, and writes it as a PNG to `path` (all or nothing,
+/// radiosity/output/output_file.h). Returns the render's seconds.
 double write_render(const SceneRun& run, const Solution& solution, const std::string& path,
                     const RenderOptions& options = {});
 

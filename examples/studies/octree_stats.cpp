@@ -256,11 +256,6 @@ QueryRow measure_any(const mbr::Octree& octree, const std::vector<mbr::Ray>& ray
     return row;
 }
 
-bool ends_with(const std::string& s, const std::string& suffix) {
-    return s.size() >= suffix.size() &&
-           s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
-}
-
 // The rows of the text table and of the CSV table (which leads with the scene and the octree).
 // Returns the number of disagreements over both queries.
 long fill_tables(const std::string& path, const mbr::Scene& scene, const mbr::Octree& octree,
@@ -321,7 +316,7 @@ int run(mbr::Args& args) {
     if (files.size() != 1) throw mbr::UsageError("expected one SCENE file");
 
     const std::string& path = files[0];
-    mbr::Scene scene = ends_with(path, ".obj") ? mbr::load_obj(path) : mbr::load_scene(path);
+    mbr::Scene scene = mbr::is_obj_path(path) ? mbr::load_obj(path) : mbr::load_scene(path);
     if (has_tessellation) scene.settings.tessellation = tessellation_option;
 
     mbr::ScenePolygonStats polygon_stats;

@@ -91,6 +91,29 @@ Surface Surface::disk(Vec3 centre, Vec3 normal, Vec3 e1, double r0, double r1, d
     return s;
 }
 
+Surface Surface::reversed() const {
+    Surface s = *this;
+    switch (kind_) {
+        case Kind::PlanarQuad:
+        case Kind::BilinearPatch:
+            std::swap(s.p_[1], s.p_[3]);  // (u, v) -> (v, u): x_u x x_v turns around
+            break;
+        case Kind::Cylinder:
+        case Kind::Sphere:
+            s.inward_ = !inward_;
+            break;
+        case Kind::Disk:
+            // The normal, and e2 = normal x e1 with it; the angles negated, so that phi' = -phi
+            // reaches the same points of the sector.
+            s.e3_ = -e3_;
+            s.e2_ = -e2_;
+            s.a0_ = -a1_;
+            s.a1_ = -a0_;
+            break;
+    }
+    return s;
+}
+
 // The curved kinds map (u,v) to angles; `inward` mirrors one parameter so that x_u x x_v turns
 // around: u for cylinders, v (the polar angle) for spheres, whose natural orientation is inward.
 

@@ -48,6 +48,10 @@ public:
                         double phi1);
 
     Kind kind() const { return kind_; }
+    /// The same surface facing the other way: the same points, the normal turned around (a
+    /// quad's u and v swapped, a cylinder's or sphere's inward flag toggled, a disk's normal,
+    /// second axis and angles negated).
+    Surface reversed() const;
     /// x(u,v).
     Vec3 point(double u, double v) const;
     /// The partial derivatives x_u and x_v.

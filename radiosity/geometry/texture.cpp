@@ -102,25 +102,75 @@ Texture Texture::from_pixels(int width, int height, std::vector<Rgb> linear, Rgb
 
 namespace {
 
-/// True when the file begins with the PNG signature; width and height are then those of its
+/// True when the bytes begin with the PNG signature; width and height are then those of its
 /// IHDR chunk, or -1 when the header is cut short or does not begin with IHDR.
-bool is_png(const std::string& path, long& width, long& height) {
-    unsigned char h[24] = {};
-    std::ifstream in(path, std::ios::binary);
-    in.read(reinterpret_cast<char*>(h), sizeof h);
-    const std::streamsize n = in.gcount();
+bool is_png(const std::string& bytes, long& width, long& height) {
     static const unsigned char signature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
-    if (n < 8) return false;
-    for (int i = 0; i < 8; ++i)
-        if (h[i] != signature[i]) return false;
+    const auto h = [&](size_t i) { return static_cast<unsigned char>(bytes[i]); };
+    if (bytes.size() < 8) return false;
+    for (size_t i = 0; i < 8; ++i)
+        if (h(i) != signature[i]) return false;
     width = height = -1;
-    if (n < 24 || h[12] != 'I' || h[13] != 'H' || h[14] != 'D' || h[15] != 'R') return true;
-    const auto big_endian = [&](int at) {
-        return (long(h[at]) << 24) | (long(h[at + 1]) << 16) | (long(h[at + 2]) << 8) | h[at + 3];
+    if (bytes.size() < 24 || bytes.compare(12, 4, "IHDR") != 0) return true;
+    const auto big_endian = [&](size_t at) {
+        return (long(h(at)) << 24) | (long(h(at + 1)) << 16) | (long(h(at + 2)) << 8) | h(at + 3);
     };
     width = big_endian(16);
     height = big_endian(20);
     return true;
+}
+
+/// The largest texture file read (bytes): beyond what the largest image accepted takes
+/// uncompressed at four channels, with room for headers.
+constexpr long max_image_file_bytes = 4 * Texture::max_image_pixels + (1L << 20);
+
+/// The whole file at `path` (a regular file, checked by the caller), or InputError(path, 0, ...)
+/// when it cannot be opened or read, or is larger than max_image_file_bytes.
+std::string read_image_file(const std::string& path) {
+    errno = 0;
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw InputError(path, 0, "cannot open the texture file" + system_reason());
+    std::string bytes;
+    char buffer[1 << 16];
+    while (in.read(buffer, sizeof buffer) || in.gcount() > 0) {
+        bytes.append(buffer, size_t(in.gcount()));
+        if (long(bytes.size()) > max_image_file_bytes)
+            throw InputError(path, 0,
+                             "the texture file is larger than " +
+                                 std::to_string(max_image_file_bytes >> 20) +
+                                 " MiB; no image mbr accepts needs that much");
+    }
+    if (in.bad()) throw InputError(path, 0, "cannot read the texture file" + system_reason());
+    return bytes;
+}
+
+/// A BMP with a BITMAPV3INFOHEADER (56 bytes: the 40 of BITMAPINFOHEADER, then the red, green,
+/// blue and alpha masks), which image editors write for 16-bit pixels, is one stb_image refuses.
+/// It is rewritten in memory as the BITMAPINFOHEADER that stb_image reads: the header's size set
+/// to 40, followed by the three colour masks when the pixels are bit fields (compression 3) and
+/// by nothing otherwise, the masks it does not read (alpha, which mbr ignores) cut out, and the
+/// pixels' offset in the file header moved back by the bytes cut.
+void accept_bmp_v3_header(std::string& bytes) {
+    if (bytes.size() < 14 + 56 || bytes[0] != 'B' || bytes[1] != 'M') return;
+    const auto u32 = [&](size_t i) {
+        const auto b = [&](size_t k) {
+            return static_cast<unsigned long>(static_cast<unsigned char>(bytes[k]));
+        };
+        return b(i) | (b(i + 1) << 8) | (b(i + 2) << 16) | (b(i + 3) << 24);
+    };
+    const auto set_u32 = [&](size_t i, unsigned long x) {
+        for (size_t k = 0; k < 4; ++k) bytes[i + k] = static_cast<char>((x >> (8 * k)) & 0xff);
+    };
+    if (u32(14) != 56) return;
+    const unsigned long offset = u32(10);
+    const bool bit_fields = u32(14 + 16) == 3;
+    const size_t keep = 14 + 40 + (bit_fields ? 12 : 0);  // what stb_image reads of the header
+    const size_t cut = 14 + 56 - keep;
+    if (offset < 14 + 56) return;  // pixels inside the header: leave it to stb_image to refuse
+    bytes.erase(keep, cut);
+    set_u32(14, 40);
+    set_u32(10, offset - cut);
+    set_u32(2, static_cast<unsigned long>(bytes.size()));
 }
 
 /// A byte string for a message: printable ASCII as is, other bytes as \xHH.
@@ -168,18 +218,18 @@ Texture Texture::image(const std::string& path, Rgb scale) {
     if (!ec && fs::is_directory(st)) throw InputError(path, 0, "is a folder, not a file");
     if (!ec && fs::exists(st) && !fs::is_regular_file(st))
         throw InputError(path, 0, "is not a regular file");
+    std::string bytes = read_image_file(path);
+    accept_bmp_v3_header(bytes);
+    const auto* data_in = reinterpret_cast<const stbi_uc*>(bytes.data());
+    const int n_bytes = int(bytes.size());
     // Ask for the size first, so that an absurd header cannot make stb_image allocate gigabytes.
     int width = 0, height = 0, channels = 0;
-    if (!stbi_info(path.c_str(), &width, &height, &channels)) {
-        errno = 0;
-        std::FILE* f = std::fopen(path.c_str(), "rb");
-        if (!f) throw InputError(path, 0, "cannot open the texture file" + system_reason());
-        std::fclose(f);
+    if (!stbi_info_from_memory(data_in, n_bytes, &width, &height, &channels)) {
         const std::string why = failure_reason(stbi_failure_reason(), "unknown format");
         // stb_image refuses a PNG header of more than 2^30 bytes of pixels ("too large") and
         // then reports the last format it tried ("unknown image type"): say what the header says.
         long png_width = 0, png_height = 0;
-        if (is_png(path, png_width, png_height)) {
+        if (is_png(bytes, png_width, png_height)) {
             if (png_width > 0 && png_height > 0 && png_width * png_height > max_image_pixels)
                 throw InputError(path, 0, too_many_pixels(png_width, png_height));
             throw InputError(path, 0,
@@ -189,11 +239,12 @@ Texture Texture::image(const std::string& path, Rgb scale) {
     }
     if (width < 1 || height < 1 || long(width) * long(height) > max_image_pixels)
         throw InputError(path, 0, too_many_pixels(width, height));
-    unsigned char* data = stbi_load(path.c_str(), &width, &height, &channels, 3);
+    unsigned char* data = stbi_load_from_memory(data_in, n_bytes, &width, &height, &channels, 3);
     if (!data) {
         const std::string why = failure_reason(stbi_failure_reason(), "unknown error");
         throw InputError(path, 0, "cannot decode the texture image (" + why + ")");
     }
+    bytes = std::string();  // the file's bytes are not needed beside the decoded texels
     auto pixels = std::make_shared<Pixels>();
     pixels->width = width;
     pixels->height = height;
@@ -218,10 +269,44 @@ Texture Texture::scaled(Rgb scale) const {
     t.a_ = a_ * scale;
     t.b_ = b_ * scale;
     t.scale_ = scale_ * scale;
+    t.mapped_mean_ = mapped_mean_ * scale;
+    return t;
+}
+
+namespace {
+
+/// A texture coordinate inside [0,1] as it is; outside, its fractional part (the texture
+/// repeats). NaN stays NaN, which clamp01 reads as 0.
+double wrap01(double x) {
+    return (x >= 0 && x <= 1) ? x : x - std::floor(x);
+}
+
+}  // namespace
+
+Texture Texture::mapped(const CornerCoordinates& corners) const {
+    if (kind_ == Kind::Constant) return *this;  // no coordinates change a constant
+    Texture t = *this;
+    t.corners_ = corners;
+    // The mean of what the coordinates show: a midpoint rule of 16 x 16 points.
+    constexpr int n = 16;
+    Rgb sum;
+    t.mapped_ = true;
+    for (int j = 0; j < n; ++j)
+        for (int i = 0; i < n; ++i) sum += t.value((i + 0.5) / n, (j + 0.5) / n);
+    t.mapped_mean_ = sum * (1.0 / (n * n));
     return t;
 }
 
 Rgb Texture::value(double u, double v) const {
+    if (!mapped_) return unmapped_value(u, v);
+    // The bilinear blend of the corners' coordinates (corners at (0,0), (1,0), (1,1), (0,1)).
+    const double a = (1 - u) * (1 - v), b = u * (1 - v), c = u * v, d = (1 - u) * v;
+    const CornerCoordinates& k = corners_;
+    return unmapped_value(wrap01(a * k[0][0] + b * k[1][0] + c * k[2][0] + d * k[3][0]),
+                          wrap01(a * k[0][1] + b * k[1][1] + c * k[2][1] + d * k[3][1]));
+}
+
+Rgb Texture::unmapped_value(double u, double v) const {
     switch (kind_) {
         case Kind::Constant:
             return a_;
@@ -263,6 +348,7 @@ bool Texture::is_constant() const {
 }
 
 Rgb Texture::mean() const {
+    if (mapped_) return mapped_mean_;
     switch (kind_) {
         case Kind::Constant:
             return a_;

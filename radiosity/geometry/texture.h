@@ -4,6 +4,7 @@
 // an image (PNG, JPEG, ... through stb_image) looked up bilinearly.
 #pragma once
 
+#include <array>
 #include <memory>
 #include <string>
 #include <vector>
@@ -40,6 +41,18 @@ public:
     /// This field multiplied channel by channel by `scale`. An image's copy shares its texels
     /// (only the scale differs), so scaling costs no memory.
     Texture scaled(Rgb scale) const;
+
+    /// Texture coordinates (OBJ's `vt`) at a surface's four parameter corners, in the order of
+    /// Surface::planar_quad's corners: (u,v) = (0,0), (1,0), (1,1), (0,1).
+    using CornerCoordinates = std::array<std::array<double, 2>, 4>;
+    /// This field seen through texture coordinates: value(u, v) reads the field at the bilinear
+    /// blend of `corners` at (u, v), wrapped into [0,1] where it falls outside (a texture
+    /// repeats, as OBJ viewers show it). The copy shares the texels; its mean() is taken over
+    /// the part of the field it shows (a 16 x 16 midpoint rule), its minimum() and maximum()
+    /// stay the whole field's (bounds of what it shows).
+    Texture mapped(const CornerCoordinates& corners) const;
+    /// True when the field is seen through texture coordinates (mapped()).
+    bool is_mapped() const { return mapped_; }
 
     /// Largest image accepted (pixels), a guard against absurd headers and memory exhaustion.
     static constexpr long max_image_pixels = 1L << 25;
@@ -87,9 +100,14 @@ private:
     static Texture from_shared(std::shared_ptr<const Pixels> pixels, Rgb scale,
                                const std::string& name);
     Kind kind_ = Kind::Constant;
-    Rgb a_, b_;           // constant value; checker colours
-    int n_ = 0;           // checker squares per side
-    Rgb scale_{1, 1, 1};  // an image's scale, applied to its texels on lookup
+    Rgb a_, b_;            // constant value; checker colours
+    int n_ = 0;            // checker squares per side
+    Rgb scale_{1, 1, 1};   // an image's scale, applied to its texels on lookup
+    bool mapped_ = false;  // value() reads through corners_ (mapped())
+    CornerCoordinates corners_{};
+    Rgb mapped_mean_;  // mean() of a mapped field
+    /// value() without the texture coordinates: the field at (u, v) of its own square.
+    Rgb unmapped_value(double u, double v) const;
     std::shared_ptr<const Pixels> pixels_;
     std::string source_;
 };

@@ -11,6 +11,7 @@
 #include <tuple>
 
 #include "math/check.h"
+#include "radiosity/scene/obj_reader.h"
 
 namespace mbr {
 
@@ -113,6 +114,18 @@ std::string material_name(const Scene& scene, int surface) {
     return "'" + scene.material_of(surface).name + "'";
 }
 
+/// True when materials a and b are one, or copies of one made for texture coordinates (the OBJ
+/// reader names them MATERIAL@LINE.K): the same material in the file's terms.
+bool same_family(const Scene& scene, int a, int b) {
+    if (a == b) return true;
+    const auto family = [&](int m) {
+        const std::string& name = scene.materials[size_t(m)].name;
+        const size_t at = name.rfind('@');
+        return at == std::string::npos ? name : name.substr(0, at);
+    };
+    return family(a) == family(b);
+}
+
 }  // namespace
 
 double duplicate_tolerance(const Box3& bounds) {
@@ -201,8 +214,8 @@ std::vector<DuplicateSurface> find_duplicate_surfaces(const Scene& scene) {
     return out;
 }
 
-void drop_duplicate_surfaces(Scene& scene) {
-    const std::vector<DuplicateSurface> repeats = find_duplicate_surfaces(scene);
+void drop_duplicate_surfaces(Scene& scene, const ImportOptions& options) {
+    std::vector<DuplicateSurface> repeats = find_duplicate_surfaces(scene);
     if (repeats.empty()) return;
     auto file_of = [&](int i) {
         const int src = scene.surfaces[size_t(i)].source;
@@ -211,9 +224,40 @@ void drop_duplicate_surfaces(Scene& scene) {
     };
     auto name_of = [&](int i) { return "'" + scene.surfaces[size_t(i)].name + "'"; };
     // A repeat with another material is an error before anything changes: which of the two is
-    // meant is the user's to say.
+    // meant is the user's to say. In a forgiving import (the repeat read from an OBJ file) the
+    // first is kept, with a warning of its own.
+    const auto same_material = [&](const DuplicateSurface& d) {
+        return same_family(scene, scene.surfaces[size_t(d.later)].material,
+                           scene.surfaces[size_t(d.earlier)].material);
+    };
+    std::vector<int> other_material;
     for (const DuplicateSurface& d : repeats)
-        if (scene.surfaces[size_t(d.later)].material != scene.surfaces[size_t(d.earlier)].material)
+        if (!same_material(d) && !options.strict && is_obj_path(file_of(d.later))) {
+            if (other_material.empty()) {
+                SceneWarning w;
+                w.kind = "duplicate surface with another material";
+                w.file = file_of(d.later);
+                w.line = scene.surfaces[size_t(d.later)].line;
+                w.message = "surface " + name_of(d.later) + " repeats surface " +
+                            name_of(d.earlier) + " (" + scene.where(d.earlier) +
+                            ") with another material: " + material_name(scene, d.later) +
+                            " here, " + material_name(scene, d.earlier) +
+                            " there; the first is kept and the repeat dropped";
+                w.count = 0;
+                scene.warn(w);
+            }
+            other_material.push_back(d.later);
+        }
+    if (!other_material.empty()) {
+        for (SceneWarning& w : scene.warnings)
+            if (w.kind == "duplicate surface with another material")
+                w.count += long(other_material.size());
+        repeats.erase(std::remove_if(repeats.begin(), repeats.end(),
+                                     [&](const DuplicateSurface& d) { return !same_material(d); }),
+                      repeats.end());
+    }
+    for (const DuplicateSurface& d : repeats)
+        if (!same_material(d))
             throw InputError(file_of(d.later), scene.surfaces[size_t(d.later)].line,
                              "surface " + name_of(d.later) + " repeats surface " +
                                  name_of(d.earlier) + " (" + scene.where(d.earlier) +
@@ -221,6 +265,21 @@ void drop_duplicate_surfaces(Scene& scene) {
                                  " here, " + material_name(scene, d.earlier) +
                                  " there; surfaces are one-sided and each reflects and emits, "
                                  "so remove one of them");
+    std::vector<char> drop(scene.surfaces.size(), 0);
+    for (int i : other_material) drop[size_t(i)] = 1;
+    const auto drop_marked = [&] {
+        size_t k = 0;
+        for (size_t i = 0; i < scene.surfaces.size(); ++i)
+            if (!drop[i]) {
+                if (k != i) scene.surfaces[k] = std::move(scene.surfaces[i]);
+                ++k;
+            }
+        scene.surfaces.resize(k);
+    };
+    if (repeats.empty()) {
+        drop_marked();
+        return;
+    }
     // One instance per repeated statement: a statement that makes several surfaces (a box, an
     // OBJ triangle's three quads) and repeats another counts once.
     using Pair = std::tuple<int, int, int, int>;  // later source, line; earlier source, line
@@ -250,15 +309,8 @@ void drop_duplicate_surfaces(Scene& scene) {
                     name_of(first.later) + ") repeat those of " + scene.where(first.earlier) +
                     " (the first " + name_of(first.earlier) + ")" + same +
                     "; the repeats are dropped";
-    std::vector<char> drop(scene.surfaces.size(), 0);
     for (const DuplicateSurface& d : repeats) drop[size_t(d.later)] = 1;
-    size_t k = 0;
-    for (size_t i = 0; i < scene.surfaces.size(); ++i)
-        if (!drop[i]) {
-            if (k != i) scene.surfaces[k] = std::move(scene.surfaces[i]);
-            ++k;
-        }
-    scene.surfaces.resize(k);
+    drop_marked();
     scene.warn(w);
 }
 

@@ -47,7 +47,10 @@ std::vector<DuplicateSurface> find_duplicate_surfaces(const Scene& scene);
 /// (the first repeated statement at its file:line naming the first statement's, and the number
 /// of repeated statements); a repeat with another material is an InputError at its statement's
 /// file:line naming both statements and both materials, raised before anything is dropped.
-/// Surfaces that coincide but face opposite ways (a two-sided wall) are both kept.
-void drop_duplicate_surfaces(Scene& scene);
+/// Surfaces that coincide but face opposite ways (a two-sided wall) are both kept. In a
+/// forgiving import (options.strict off) a repeat with another material read from an OBJ file
+/// is dropped instead, with one warning of kind "duplicate surface with another material".
+/// Copies of one material made for texture coordinates (MATERIAL@LINE.K) count as the same.
+void drop_duplicate_surfaces(Scene& scene, const ImportOptions& options = {});
 
 }  // namespace mbr

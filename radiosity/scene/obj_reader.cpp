@@ -2,15 +2,20 @@
 // each face to planar quads (faces_to_quads.h), MTL materials to reflectance and emission.
 #include "radiosity/scene/obj_reader.h"
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <istream>
+#include <limits>
+#include <memory>
 #include <unordered_set>
 
 #include "math/check.h"
 #include "radiosity/scene/duplicate_faces.h"
 #include "radiosity/scene/faces_to_quads.h"
+#include "radiosity/scene/light_sides.h"
 
 namespace mbr {
 
@@ -26,11 +31,114 @@ constexpr int max_face_vertices = 256;  // ear clipping (faces_to_quads.cpp) is 
 struct MtlEntry {
     std::string name;
     Line newmtl_line;
-    Rgb kd{0.5, 0.5, 0.5}, ke{0, 0, 0};
+    Rgb kd{0.5, 0.5, 0.5}, ke{0, 0, 0}, ks{0, 0, 0}, tf{0, 0, 0};
     bool has_kd = false;
+    int illum = -1;  // -1: none given
     std::string map_kd, map_ke;
     Line map_kd_line, map_ke_line;
 };
+
+/// The largest reflectance a forgiving import clamps a Kd of 1 or more to: below 1, as the
+/// radiosity iteration needs (a reflectance of 1 never converges), and close to what was meant.
+constexpr double max_clamped_reflectance = 0.99;
+
+/// A texture vertex or vertex that its statement could not define (forgiving import).
+constexpr double unusable = std::numeric_limits<double>::quiet_NaN();
+
+/// True when the first coordinate marks an unusable vertex.
+bool is_unusable(double x) {
+    return std::isnan(x);
+}
+
+/// Texture coordinates (u, v) of points in a face's plane: the affine map that best fits the
+/// face's vertices (least squares over them; exact for a triangle, and for any face whose
+/// coordinates are affine in its plane, such as a parallelogram's), used for the quads that
+/// face_to_quads makes from a face with `vt`.
+class FaceCoordinates {
+public:
+    FaceCoordinates(const std::vector<Vec3>& p, const std::vector<std::array<double, 2>>& uv)
+        : p_(p), uv_(uv) {
+        // The plane's frame: origin p0, e1 along the longest edge from p0, e2 in the plane.
+        Vec3 n;  // Newell's normal
+        for (size_t i = 0; i < p.size(); ++i) n += cross(p[i], p[(i + 1) % p.size()]);
+        origin_ = p[0];
+        size_t far = 1;
+        for (size_t i = 1; i < p.size(); ++i)
+            if (length(p[i] - origin_) > length(p[far] - origin_)) far = i;
+        e1_ = normalize(p[far] - origin_);
+        e2_ = normalize(cross(normalize(n), e1_));
+        // Normal equations of the fit uv = a x + b y + c, solved by Cramer's rule.
+        double m[3][3] = {}, r[2][3] = {};
+        for (size_t k = 0; k < p.size(); ++k) {
+            const double x[3] = {dot(p[k] - origin_, e1_), dot(p[k] - origin_, e2_), 1};
+            for (int i = 0; i < 3; ++i) {
+                for (int j = 0; j < 3; ++j) m[i][j] += x[i] * x[j];
+                for (int c = 0; c < 2; ++c) r[c][i] += x[i] * uv[k][size_t(c)];
+            }
+        }
+        const auto det = [](const double a[3][3]) {
+            return a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1]) -
+                   a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0]) +
+                   a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0]);
+        };
+        const double d = det(m);
+        for (int c = 0; c < 2; ++c)
+            for (int i = 0; i < 3; ++i) {
+                double mi[3][3];
+                for (int a = 0; a < 3; ++a)
+                    for (int b = 0; b < 3; ++b) mi[a][b] = b == i ? r[c][a] : m[a][b];
+                coefficient_[c][i] = d != 0 ? det(mi) / d : 0;
+            }
+    }
+
+    /// The coordinates at q: a vertex of the face keeps its own `vt`; any other point of the
+    /// plane gets the fitted affine map's.
+    std::array<double, 2> at(Vec3 q) const {
+        for (size_t k = 0; k < p_.size(); ++k)
+            if (p_[k] == q) return uv_[k];
+        const double x = dot(q - origin_, e1_), y = dot(q - origin_, e2_);
+        return {coefficient_[0][0] * x + coefficient_[0][1] * y + coefficient_[0][2],
+                coefficient_[1][0] * x + coefficient_[1][1] * y + coefficient_[1][2]};
+    }
+
+private:
+    std::vector<Vec3> p_;
+    std::vector<std::array<double, 2>> uv_;
+    Vec3 origin_, e1_, e2_;
+    double coefficient_[2][3] = {};
+};
+
+/// The candidates for a file an OBJ or MTL file names: as written, relative to the naming
+/// file's folder; then, for a forgiving import, with '\' read as '/', as its base name in that
+/// folder, and as the base name spelt in another case (exporters write absolute or Windows
+/// paths, or folders of the machine they ran on). The first that exists as a regular file, or
+/// "" when none does.
+std::string locate(const std::string& from, const std::string& file) {
+    std::vector<std::string> candidates{resolve(from, file)};
+    std::string slashed = file;
+    std::replace(slashed.begin(), slashed.end(), '\\', '/');
+    candidates.push_back(resolve(from, slashed));
+    const fs::path folder = fs::path(from).parent_path();
+    const std::string base = fs::path(slashed).filename().string();
+    if (base.empty()) return "";
+    candidates.push_back((folder / base).string());
+    for (const std::string& c : candidates)
+        if (file_problem(c).empty()) return c;
+    // The base name in another case, among the folder's files.
+    std::error_code ec;
+    const auto lower = [](std::string t) {
+        for (char& c : t) c = char(std::tolower(static_cast<unsigned char>(c)));
+        return t;
+    };
+    const std::string wanted = lower(base);
+    fs::directory_iterator it(folder.empty() ? fs::path(".") : folder, ec), end;
+    for (int n = 0; !ec && it != end && n < 100000; it.increment(ec), ++n)
+        if (lower(it->path().filename().string()) == wanted) {
+            const std::string found = (folder / it->path().filename()).string();
+            if (file_problem(found).empty()) return found;
+        }
+    return "";
+}
 
 class ObjReader {
 public:
@@ -44,14 +152,78 @@ public:
         LineReader reader(in, name_);
         Line line;
         while (reader.next(line)) statement(line);
-        if (scene_.surfaces.empty()) throw InputError(name_, 0, "the OBJ file has no faces");
+        if (scene_.surfaces.empty()) {
+            std::string why = "the OBJ file has no faces";
+            for (const SceneWarning& w : scene_.warnings)
+                if (w.kind == "face dropped")
+                    why += " that can be used (" + counted(w.count, "face was", "faces were") +
+                           " dropped: the first at line " + std::to_string(w.line) + ", " +
+                           w.message + ")";
+            throw InputError(name_, 0, why);
+        }
         name_surfaces();
         scene_.input_files = state_.files();
         return std::move(scene_);
     }
 
 private:
+    bool strict() const { return state_.options().strict; }
+
+    /// A forgiving import's record of a repaired fault: one warning of `kind` (Scene::warn
+    /// keeps the first instance and counts the rest).
+    void warn(const std::string& kind, const std::string& file, int line,
+              const std::string& message) {
+        SceneWarning w;
+        w.kind = kind;
+        w.file = file;
+        w.line = line;
+        w.message = message;
+        scene_.warn(w);
+    }
+
+    /// A fault met at `line`: refused when the import is strict, else a warning of `kind`
+    /// saying `message` and what the import does instead (`then`).
+    void fault(const Line& line, const std::string& kind, const std::string& message,
+               const std::string& then) {
+        if (strict()) line.fail(message);
+        warn(kind, line.file, line.number, message + "; " + then);
+    }
+
+    /// One OBJ statement. A forgiving import repairs what its statement could not do: an
+    /// unusable vertex keeps its place in the numbering (faces that use it are dropped), a face
+    /// that cannot be made is dropped, an unknown material gives the default one, and any other
+    /// statement that fails is skipped.
     void statement(const Line& line) {
+        try {
+            obj_statement(line);
+        } catch (const InputError& e) {
+            if (strict()) throw;
+            const std::string& key = line[0];
+            const std::string at = e.message();
+            if (key == "v") {
+                v_.push_back({unusable, 0, 0});
+                warn("unusable vertex", e.file(), e.line(),
+                     at + "; faces that use this vertex are dropped");
+            } else if (key == "vt") {
+                vt_.push_back({unusable, 0});
+                warn("unusable texture vertex", e.file(), e.line(),
+                     at + "; faces that use it show their texture without coordinates");
+            } else if (key == "vn") {
+                ++n_vn_;
+                warn("statement skipped", e.file(), e.line(), at + "; the statement is skipped");
+            } else if (key == "f") {
+                warn("face dropped", e.file(), e.line(), at + "; the face is dropped");
+            } else if (key == "usemtl") {
+                material_ = default_material();
+                warn("unknown material", e.file(), e.line(),
+                     at + "; the faces that follow get the default material (grey 0.5)");
+            } else {
+                warn("statement skipped", e.file(), e.line(), at + "; the statement is skipped");
+            }
+        }
+    }
+
+    void obj_statement(const Line& line) {
         const std::string& key = line[0];
         if (key == "v") {
             if (line.size() != 4 && line.size() != 5 && line.size() != 7)
@@ -63,12 +235,23 @@ private:
             for (size_t i = 4; i < line.size(); ++i) parse_double(line, line[i], "vertex w/colour");
             check_point(line, p, "vertex");
             v_.push_back(p);
-        } else if (key == "vt" || key == "vp") {
+        } else if (key == "vt") {
             if (line.size() < 2 || line.size() > 4)
-                line.fail("'" + key + "' needs 1 to 3 numbers, found " +
-                          std::to_string(line.size() - 1));
+                line.fail("'vt' needs 1 to 3 numbers, found " + std::to_string(line.size() - 1));
+            std::array<double, 2> uv{0, 0};
+            for (size_t i = 1; i < line.size(); ++i) {
+                const double x = parse_double(line, line[i], key);
+                if (i <= 2) uv[i - 1] = x;
+            }
+            for (double x : uv)
+                if (std::abs(x) > max_coordinate)
+                    line.fail("texture coordinate " + fmt(x) + " exceeds the limit " +
+                              fmt(max_coordinate));
+            vt_.push_back(uv);
+        } else if (key == "vp") {
+            if (line.size() < 2 || line.size() > 4)
+                line.fail("'vp' needs 1 to 3 numbers, found " + std::to_string(line.size() - 1));
             for (size_t i = 1; i < line.size(); ++i) parse_double(line, line[i], key);
-            if (key == "vt") ++n_vt_;
         } else if (key == "vn") {
             if (line.size() != 4)
                 line.fail("'vn' needs 3 numbers, found " + std::to_string(line.size() - 1));
@@ -88,7 +271,7 @@ private:
             material_ = it->second;
         } else if (key == "mtllib") {
             if (line.size() < 2) line.fail("'mtllib' needs a file name");
-            for (size_t i = 1; i < line.size(); ++i) mtllib(line, resolve(name_, line[i]));
+            for (size_t i = 1; i < line.size(); ++i) mtllib(line, line[i]);
         } else if (key == "s") {
             if (line.size() != 2) line.fail("'s' needs one value (a group number or 'off')");
             if (line[1] != "off" && line[1] != "on")
@@ -128,6 +311,8 @@ private:
             line.fail("face has " + std::to_string(line.size() - 1) + " vertices; at most " +
                       std::to_string(max_face_vertices) + " are accepted");
         std::vector<Vec3> p;
+        std::vector<std::array<double, 2>> uv;
+        bool all_uv = true;
         for (size_t t = 1; t < line.size(); ++t) {
             // v, v/vt, v//vn or v/vt/vn.
             const std::string& ref = line[t];
@@ -142,21 +327,57 @@ private:
                 (parts.size() == 3 && parts[2].empty()))
                 line.fail("malformed face vertex " + in_quotes(ref) +
                           " (expected v, v/vt, v//vn or v/vt/vn)");
-            p.push_back(v_[size_t(index(line, parts[0], long(v_.size()), "vertex", "vertices"))]);
-            if (parts.size() >= 2 && !parts[1].empty())
-                index(line, parts[1], n_vt_, "texture vertex", "texture vertices");
+            const long long k = index(line, parts[0], long(v_.size()), "vertex", "vertices");
+            if (is_unusable(v_[size_t(k)][0]))
+                line.fail("the face uses vertex " + parts[0] + ", which its line could not define");
+            p.push_back(v_[size_t(k)]);
+            if (parts.size() >= 2 && !parts[1].empty()) {
+                const auto& c = vt_[size_t(
+                    index(line, parts[1], long(vt_.size()), "texture vertex", "texture vertices"))];
+                if (is_unusable(c[0])) all_uv = false;
+                uv.push_back(c);
+            } else {
+                all_uv = false;
+            }
             if (parts.size() == 3) index(line, parts[2], n_vn_, "normal", "normals");
         }
         if (material_ < 0) material_ = default_material();
-        for (const Quad& q : face_to_quads(line, p)) {
+        const std::vector<Quad> quads = face_to_quads(line, p);
+        // Texture coordinates matter only for a textured material: its quads get copies of it
+        // seen through their corners' coordinates (Texture::mapped).
+        const Material& base = scene_.materials[size_t(material_)];
+        const bool textured = !base.reflectance.is_constant() || !base.emission.is_constant();
+        const FaceCoordinates* coordinates = nullptr;
+        std::unique_ptr<FaceCoordinates> fit;
+        if (all_uv && textured) {
+            fit = std::make_unique<FaceCoordinates>(p, uv);
+            coordinates = fit.get();
+        }
+        for (size_t k = 0; k < quads.size(); ++k) {
+            const Quad& q = quads[k];
             SceneSurface s;
             s.name = group_;
             s.surface = Surface::planar_quad(q[0], q[1], q[2], q[3]);
-            s.material = material_;
+            s.material = coordinates ? mapped_material(*coordinates, q, line, k) : material_;
             s.source = 0;
             s.line = line.number;
             scene_.surfaces.push_back(std::move(s));
         }
+    }
+
+    /// A copy of the current material for one quad of a face with texture coordinates, named
+    /// MATERIAL@LINE.K (docs/scene-format.md, "OBJ import"): its textures are seen through the
+    /// coordinates at the quad's corners.
+    int mapped_material(const FaceCoordinates& coordinates, const Quad& q, const Line& line,
+                        size_t k) {
+        Texture::CornerCoordinates corners;
+        for (size_t c = 0; c < 4; ++c) corners[c] = coordinates.at(q[c]);
+        Material m = scene_.materials[size_t(material_)];
+        m.name += "@" + std::to_string(line.number) + "." + std::to_string(k);
+        m.reflectance = m.reflectance.mapped(corners);
+        m.emission = m.emission.mapped(corners);
+        scene_.materials.push_back(std::move(m));
+        return int(scene_.materials.size()) - 1;
     }
 
     int default_material() {
@@ -189,7 +410,23 @@ private:
         }
     }
 
-    void mtllib(const Line& at, const std::string& path) {
+    /// `mtllib FILE`: the library beside the OBJ file, or (forgiving) wherever locate() finds
+    /// it, with a warning; one that cannot be found is skipped with a warning.
+    void mtllib(const Line& at, const std::string& file) {
+        std::string path = resolve(name_, file);
+        if (!strict() && !file_problem(path).empty()) {
+            const std::string found = locate(name_, file);
+            if (found.empty()) {
+                warn("material library not found", at.file, at.number,
+                     "material library " + in_quotes(path) + ": " + file_problem(path) +
+                         "; faces that use its materials get the default material (grey 0.5)");
+                return;
+            }
+            warn("material library found elsewhere", at.file, at.number,
+                 "material library " + in_quotes(path) + " is not there; " + in_quotes(found) +
+                     " is read instead");
+            path = found;
+        }
         state_.charge(at);
         std::ifstream in;
         open_named(at, "material library", path, in);
@@ -199,20 +436,27 @@ private:
         MtlEntry entry;
         bool open = false;
         while (reader.next(line)) {
-            const std::string& key = line[0];
-            if (key == "newmtl") {
-                if (open) finish_material(entry, path);
-                if (line.size() != 2) line.fail("'newmtl' needs one material name");
-                entry = MtlEntry();
-                entry.name = line[1];
-                entry.newmtl_line = line;
-                open = true;
-                continue;
+            try {
+                const std::string& key = line[0];
+                if (key == "newmtl") {
+                    if (open) finish_material(entry);
+                    open = false;
+                    if (line.size() != 2) line.fail("'newmtl' needs one material name");
+                    entry = MtlEntry();
+                    entry.name = line[1];
+                    entry.newmtl_line = line;
+                    open = true;
+                    continue;
+                }
+                if (!open) line.fail(in_quotes(key) + " before any 'newmtl'");
+                mtl_statement(line, entry);
+            } catch (const InputError& e) {
+                if (strict()) throw;
+                warn("statement skipped", e.file(), e.line(),
+                     e.message() + "; the statement is skipped");
             }
-            if (!open) line.fail(in_quotes(key) + " before any 'newmtl'");
-            mtl_statement(line, entry, path);
         }
-        if (open) finish_material(entry, path);
+        if (open) finish_material(entry);
     }
 
     /// "Kd r g b" or "Kd r" (grey); spectral and CIE XYZ forms are refused.
@@ -229,33 +473,49 @@ private:
         return c;
     }
 
-    static void mtl_statement(const Line& line, MtlEntry& e, const std::string&) {
+    void mtl_statement(const Line& line, MtlEntry& e) {
         const std::string& key = line[0];
         if (key == "Kd") {
             Rgb kd = mtl_colour(line);
+            // One fault per statement, named by its first channel out of range.
             for (int i = 0; i < 3; ++i)
-                if (!(kd[i] >= 0 && kd[i] < 1))
-                    line.fail("Kd " + fmt(kd[i]) +
+                if (!(kd[i] >= 0 && kd[i] < 1)) {
+                    fault(line, "value clamped",
+                          "Kd " + fmt(kd[i]) +
                               " is outside [0, 1): a reflectance of 1 or more makes the "
-                              "radiosity iteration diverge (scale the colour below 1)");
+                              "radiosity iteration diverge (scale the colour below 1)",
+                          "every channel is clamped to [0, " + fmt(max_clamped_reflectance) + "]");
+                    for (int k = 0; k < 3; ++k)
+                        kd[k] = std::clamp(kd[k], 0.0, max_clamped_reflectance);
+                    break;
+                }
             e.kd = kd;
             e.has_kd = true;
         } else if (key == "Ke") {
             Rgb ke = mtl_colour(line);
-            for (int i = 0; i < 3; ++i) {
-                if (ke[i] < 0) line.fail("Ke " + fmt(ke[i]) + " is negative");
-                // The scene format's limit on the emission E = pi Ke (scene.h).
-                if (Pi * ke[i] > max_emission)
-                    line.fail("Ke " + fmt(ke[i]) + " exceeds the limit " + fmt(max_emission / Pi) +
-                              " (the emission E = pi Ke is at most " + fmt(max_emission) + ")");
-            }
+            const double limit = max_emission / Pi;  // the scene format's limit of E = pi Ke
+            for (int i = 0; i < 3; ++i)
+                if (ke[i] < 0 || ke[i] > limit) {
+                    fault(line, "value clamped",
+                          ke[i] < 0 ? "Ke " + fmt(ke[i]) + " is negative"
+                                    : "Ke " + fmt(ke[i]) + " exceeds the limit " + fmt(limit) +
+                                          " (the emission E = pi Ke is at most " +
+                                          fmt(max_emission) + ")",
+                          "every channel is clamped to [0, " + fmt(limit) + "]");
+                    for (int k = 0; k < 3; ++k) ke[k] = std::clamp(ke[k], 0.0, limit);
+                    break;
+                }
             e.ke = ke;
         } else if (key == "map_Kd" || key == "map_Ke") {
             // Options (-s, -o, -bm, ...) come first; the file name is the last token.
             if (line.size() < 2) line.fail(in_quotes(key) + " needs a file name");
             (key == "map_Kd" ? e.map_kd : e.map_ke) = line[line.size() - 1];
             (key == "map_Kd" ? e.map_kd_line : e.map_ke_line) = line;
-        } else if (key == "Ka" || key == "Ks" || key == "Tf") {
+        } else if (key == "Ks" || key == "Tf") {
+            if (line.size() >= 2 && (line[1] == "spectral" || line[1] == "xyz")) return;
+            const Rgb c = mtl_colour(line);
+            (key == "Ks" ? e.ks : e.tf) = c;
+        } else if (key == "Ka") {
             if (line.size() >= 2 && (line[1] == "spectral" || line[1] == "xyz")) return;
             mtl_colour(line);
         } else if (key == "Ns" || key == "Ni" || key == "Tr" || key == "illum" ||
@@ -264,7 +524,8 @@ private:
             if (line.size() != 2)
                 line.fail(in_quotes(key) + " needs one number, found " +
                           std::to_string(line.size() - 1));
-            parse_double(line, line[1], key);
+            const double x = parse_double(line, line[1], key);
+            if (key == "illum") e.illum = (x >= 0 && x <= 10) ? int(x) : -1;
         } else if (key == "d") {
             size_t i = (line.size() == 3 && line[1] == "-halo") ? 2 : 1;
             if (line.size() != i + 1) line.fail("'d' needs one number");
@@ -277,25 +538,83 @@ private:
         }
     }
 
-    Texture mtl_texture(const Line& line, const std::string& file, Rgb scale) {
-        return state_.image(line, resolve(line.file, file)).scaled(scale);
+    /// The image `file` named on `line`, scaled, or (forgiving) found elsewhere by locate(),
+    /// or replaced by the constant `replacement` when it cannot be read.
+    Texture mtl_texture(const Line& line, const std::string& file, Rgb scale, Rgb replacement) {
+        std::string path = resolve(line.file, file);
+        if (strict()) return state_.image(line, path).scaled(scale);
+        if (!file_problem(path).empty()) {
+            const std::string found = locate(line.file, file);
+            if (!found.empty()) {
+                warn("texture found elsewhere", line.file, line.number,
+                     "texture " + in_quotes(path) + " is not there; " + in_quotes(found) +
+                         " is read instead");
+                path = found;
+            }
+        }
+        try {
+            return state_.image(line, path).scaled(scale);
+        } catch (const InputError& e) {
+            warn("texture replaced", e.file(), e.line(),
+                 e.message() + "; the material's colour " + colour_text(replacement) +
+                     " is used instead");
+            return Texture::constant(replacement);
+        }
     }
 
-    void finish_material(const MtlEntry& e, const std::string&) {
-        if (material_index_.count(e.name))
-            e.newmtl_line.fail("duplicate material " + in_quotes(e.name));
+    static std::string colour_text(Rgb c) {
+        return fmt_approx(c.r) + " " + fmt_approx(c.g) + " " + fmt_approx(c.b);
+    }
+
+    /// The material an MTL entry describes (docs/scene-format.md, "OBJ import"): Kd (or map_Kd
+    /// scaled by Kd; a black or missing Kd beside a map_Kd is read as exporters mean it, the
+    /// texture alone giving the colour, scaled by 0.9) is the reflectance; Ke (or map_Ke) is
+    /// the emitted radiance, E = pi Ke. A specular or transmitting material (Ks, Tf) without a
+    /// diffuse colour is treated as diffuse with the specular colour as its albedo; one with
+    /// both keeps the diffuse part. Either is reported.
+    void finish_material(const MtlEntry& e) {
+        if (material_index_.count(e.name)) {
+            if (strict()) e.newmtl_line.fail("duplicate material " + in_quotes(e.name));
+            warn("duplicate material", e.newmtl_line.file, e.newmtl_line.number,
+                 "duplicate material " + in_quotes(e.name) +
+                     "; the first definition is kept and this one is skipped");
+            return;
+        }
         Material m;
         m.name = e.name;
+        const bool black_kd = e.has_kd && max_abs(e.kd) == 0;
+        const Rgb specular{std::max(e.ks.r, e.tf.r), std::max(e.ks.g, e.tf.g),
+                           std::max(e.ks.b, e.tf.b)};
+        const std::string illum =
+            e.illum >= 0 ? ", illum " + std::to_string(e.illum) : std::string();
         if (!e.map_kd.empty()) {
-            Rgb scale = e.has_kd ? e.kd : Rgb{0.9, 0.9, 0.9};
-            m.reflectance = mtl_texture(e.map_kd_line, e.map_kd, scale);
+            Rgb scale = e.has_kd && !black_kd ? e.kd : Rgb{0.9, 0.9, 0.9};
+            m.reflectance = mtl_texture(e.map_kd_line, e.map_kd, scale,
+                                        e.has_kd && !black_kd ? e.kd : Rgb{0.5, 0.5, 0.5});
+        } else if ((black_kd || !e.has_kd) && max_abs(specular) > 0) {
+            Rgb albedo;
+            for (int i = 0; i < 3; ++i) albedo[i] = std::min(specular[i], max_clamped_reflectance);
+            m.reflectance = Texture::constant(albedo);
+            warn("specular material", e.newmtl_line.file, e.newmtl_line.number,
+                 "material " + in_quotes(e.name) + " is specular or transparent (" +
+                     (max_abs(e.ks) > 0 ? "Ks " + colour_text(e.ks) : std::string()) +
+                     (max_abs(e.ks) > 0 && max_abs(e.tf) > 0 ? ", " : "") +
+                     (max_abs(e.tf) > 0 ? "Tf " + colour_text(e.tf) : std::string()) + illum +
+                     "); mbr reflects diffusely only: treated as diffuse, albedo " +
+                     colour_text(albedo));
         } else {
             m.reflectance = Texture::constant(e.kd);
+            if (max_abs(e.ks) > 0)
+                warn("specular part dropped", e.newmtl_line.file, e.newmtl_line.number,
+                     "material " + in_quotes(e.name) + " has a specular part (Ks " +
+                         colour_text(e.ks) + illum + ") beside Kd " + colour_text(e.kd) +
+                         "; mbr reflects diffusely only and keeps Kd");
         }
         // MTL's Ke is emitted radiance (as in the common Cornell box files); E = pi L.
         if (!e.map_ke.empty()) {
             bool any = max_abs(e.ke) > 0;
-            m.emission = mtl_texture(e.map_ke_line, e.map_ke, Pi * (any ? e.ke : Rgb{1, 1, 1}));
+            const Rgb scale = Pi * (any ? e.ke : Rgb{1, 1, 1});
+            m.emission = mtl_texture(e.map_ke_line, e.map_ke, scale, scale);
         } else {
             m.emission = Texture::constant(Pi * e.ke);
         }
@@ -306,8 +625,9 @@ private:
     std::string name_;
     LoadState& state_;
     Scene scene_;
-    std::vector<Vec3> v_;
-    long long n_vt_ = 0, n_vn_ = 0;
+    std::vector<Vec3> v_;                    // x is NaN for an unusable vertex
+    std::vector<std::array<double, 2>> vt_;  // u is NaN for an unusable one
+    long long n_vn_ = 0;
     std::unordered_map<std::string, int> material_index_;
     int material_ = -1;
     std::string group_;
@@ -352,21 +672,31 @@ Scene read_obj(std::istream& in, const std::string& name, LoadState& state) {
 
 // An OBJ file read on its own is checked for repeated faces here; imported into a scene, by the
 // scene reader, with the scene's other surfaces.
-Scene parse_obj(std::istream& in, const std::string& name) {
-    LoadState state;
+Scene parse_obj(std::istream& in, const std::string& name, const ImportOptions& options) {
+    LoadState state(options);
     Scene scene = read_obj(in, name, state);
-    drop_duplicate_surfaces(scene);
+    drop_duplicate_surfaces(scene, options);
+    face_lights_to_the_open_side(scene, options);
     return scene;
 }
 
-Scene load_obj(const std::string& path) {
+Scene load_obj(const std::string& path, const ImportOptions& options) {
     std::ifstream in;
     open_top(path, in);
-    LoadState state;
+    LoadState state(options);
     state.record(path);
     Scene scene = read_obj(in, path, state);
-    drop_duplicate_surfaces(scene);
+    drop_duplicate_surfaces(scene, options);
+    face_lights_to_the_open_side(scene, options);
     return scene;
+}
+
+bool is_obj_path(const std::string& path) {
+    const std::string ext = fs::path(path).extension().string();
+    return ext.size() == 4 && ext[0] == '.' &&
+           std::tolower(static_cast<unsigned char>(ext[1])) == 'o' &&
+           std::tolower(static_cast<unsigned char>(ext[2])) == 'b' &&
+           std::tolower(static_cast<unsigned char>(ext[3])) == 'j';
 }
 
 }  // namespace mbr

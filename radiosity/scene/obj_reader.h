@@ -18,10 +18,15 @@ namespace mbr {
 /// one or more planar quads. A face that repeats another (same corners, same front side) is
 /// dropped with a warning in Scene::warnings, or refused when its material differs
 /// (duplicate_faces.h). The scene has no camera and default settings. Throws InputError.
-Scene load_obj(const std::string& path);
+/// Faults in the OBJ, its MTL libraries and their textures are repaired with warnings, or
+/// refused when options.strict (ImportOptions, scene.h).
+Scene load_obj(const std::string& path, const ImportOptions& options = {});
 
 /// Parses OBJ text from a stream; `name` is used in messages and to resolve `mtllib` paths.
-Scene parse_obj(std::istream& in, const std::string& name);
+Scene parse_obj(std::istream& in, const std::string& name, const ImportOptions& options = {});
+
+/// True when `path` names an OBJ file: its extension is .obj in any case (.OBJ, .Obj).
+bool is_obj_path(const std::string& path);
 
 namespace detail {
 
@@ -33,6 +38,10 @@ constexpr const char* obj_default_material = "obj_default";
 /// exponential include trees, the files opened so far, and the texture images decoded so far.
 class LoadState {
 public:
+    explicit LoadState(const ImportOptions& options = {}) : options_(options) {}
+    /// How faults in imported files are treated.
+    const ImportOptions& options() const { return options_; }
+
     /// Counts one more file read on behalf of `line` (at most 1000 per load).
     void charge(const Line& line);
 
@@ -48,6 +57,7 @@ public:
     Texture image(const Line& line, const std::string& path);
 
 private:
+    ImportOptions options_;
     int n_files_ = 0;
     std::vector<std::string> files_;                     // paths opened, in order
     std::unordered_map<std::string, Texture> textures_;  // canonical path -> decoded image

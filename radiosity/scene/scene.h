@@ -26,6 +26,9 @@ struct Material {
     std::string name;
     Texture reflectance;  // rho(u,v), channels in [0, 1)
     Texture emission;     // E(u,v), channels >= 0
+    /// Surfaces of this material are two-sided: each gets a twin facing the other way
+    /// (add_back_sides, light_sides.h), so that it emits and reflects on both sides.
+    bool two_sided = false;
     /// True when some channel of the emission is positive somewhere.
     bool emits() const { return max_abs(emission.maximum()) > 0; }
 };
@@ -58,6 +61,16 @@ struct SceneWarning {
 
     /// "FILE:LINE: MESSAGE", with " (and N more like it)" when count > 1.
     std::string text() const;
+};
+
+/// How the readers treat faults in imported files: OBJ, its MTL libraries and the textures
+/// they name (docs/scene-format.md, "A forgiving import"). By default a fault is repaired where
+/// the file's intent is clear (a value clamped into range, a degenerate face dropped, a missing
+/// texture replaced by its material's colour, a stray statement skipped), each kind with one
+/// warning in Scene::warnings; strict refuses the first fault with an InputError at its line.
+/// mbr's own scene format is always read strictly.
+struct ImportOptions {
+    bool strict = false;
 };
 
 /// A pinhole camera. A right-handed frame: the image's right is (look_at - eye) x up.

@@ -14,6 +14,7 @@
 #include "math/check.h"
 #include "radiosity/scene/duplicate_faces.h"
 #include "radiosity/scene/faces_to_quads.h"
+#include "radiosity/scene/light_sides.h"
 #include "radiosity/scene/line_reader.h"
 #include "radiosity/scene/obj_reader.h"
 #include "radiosity/scene/settings.h"
@@ -188,7 +189,9 @@ public:
         }
         // Every surface is in now, from this file, its includes and its OBJ imports: repeats are
         // found across all of them (duplicate_faces.h).
-        drop_duplicate_surfaces(scene_);
+        drop_duplicate_surfaces(scene_, state_.options());
+        face_lights_to_the_open_side(scene_, state_.options());
+        add_back_sides(scene_, two_sided_materials(scene_));
         scene_.input_files = state_.files();
         return std::move(scene_);
     }
@@ -231,7 +234,7 @@ private:
         }
     }
 
-    // --- material NAME [reflectance TEXTURE] [emission TEXTURE]
+    // --- material NAME [reflectance TEXTURE] [emission TEXTURE] [two_sided]
 
     void material(const Line& line) {
         if (line.size() < 2) line.fail("'material' needs a name");
@@ -247,13 +250,19 @@ private:
         bool has_reflectance = false, has_emission = false;
         for (size_t t = 2; t < line.size();) {
             const std::string& clause = line[t];
+            if (clause == "two_sided") {
+                if (m.two_sided) line.fail("'two_sided' is given twice");
+                m.two_sided = true;
+                ++t;
+                continue;
+            }
             bool refl = clause == "reflectance";
             if (!refl && clause != "emission") {
                 if (is_number_token(clause))
                     line.fail("unexpected number " + in_quotes(clause) +
                               " (too many numbers for the previous clause)");
                 line.fail("unknown material clause " + in_quotes(clause) +
-                          " (expected 'reflectance' or 'emission')");
+                          " (expected 'reflectance', 'emission' or 'two_sided')");
             }
             bool& seen_clause = refl ? has_reflectance : has_emission;
             if (seen_clause) line.fail(in_quotes(clause) + " is given twice");
@@ -678,15 +687,15 @@ private:
 
 }  // namespace
 
-Scene parse_scene(std::istream& in, const std::string& name) {
-    LoadState state;
+Scene parse_scene(std::istream& in, const std::string& name, const ImportOptions& options) {
+    LoadState state(options);
     return SceneReader(state).read(in, name);
 }
 
-Scene load_scene(const std::string& path) {
+Scene load_scene(const std::string& path, const ImportOptions& options) {
     std::ifstream in;
     open_top(path, in);
-    LoadState state;
+    LoadState state(options);
     state.record(path);
     return SceneReader(state).read(in, path);
 }

@@ -14,11 +14,13 @@ namespace mbr {
 /// Reads a scene file (docs/scene-format.md). Relative paths inside it (textures, `obj`,
 /// `include`) are relative to the file's folder. A surface that repeats another (its file,
 /// includes and OBJ imports together) is dropped with a warning in Scene::warnings, or refused
-/// when its material differs (duplicate_faces.h). Throws InputError.
-Scene load_scene(const std::string& path);
+/// when its material differs (duplicate_faces.h). The OBJ files it imports are read as `options`
+/// say (ImportOptions: forgiving or strict); the scene's own statements always strictly.
+/// Throws InputError.
+Scene load_scene(const std::string& path, const ImportOptions& options = {});
 
 /// Parses scene text from a stream; `name` is used in messages and, through its folder, to
 /// resolve relative paths. The same checks as load_scene. Throws InputError.
-Scene parse_scene(std::istream& in, const std::string& name);
+Scene parse_scene(std::istream& in, const std::string& name, const ImportOptions& options = {});
 
 }  // namespace mbr

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <limits>
+#include <mutex>
 #include <set>
 #include <stdexcept>
 
@@ -492,7 +493,7 @@ std::vector<ProgressiveSolver::Received> ProgressiveSolver::transfer_to(
         cached_candidates_ += size;
         candidates_[{h, receivers[k]}] = contexts[size_t(k)];
     }
-    auto run_one = [&](int k) {
+    auto run_transfer = [&](int k) {
         const int i = receivers[k];
         const Texture& rho = scene_.material_of(i).reflectance;
         const bool irradiance = solution_.quantity[i] == FieldQuantity::irradiance;
@@ -528,6 +529,14 @@ std::vector<ProgressiveSolver::Received> ProgressiveSolver::transfer_to(
             if (!node.is_leaf() && node.cell.in_domain())
                 results[k].splits.push_back(cell_key(node.cell));
         }
+    };
+    std::mutex progress_mutex;  // on_transfer_'s calls, one at a time
+    int n_done = 0;
+    auto run_one = [&](int k) {
+        run_transfer(k);
+        if (!on_transfer_) return;
+        std::lock_guard<std::mutex> lock(progress_mutex);
+        on_transfer_(++n_done, n_rec);
     };
     if (n_rec == 1) {
         run_one(0);  // parallel inside
@@ -780,8 +789,10 @@ Solution ProgressiveSolver::finish() {
 
 Solution solve(const Scene& scene, const Octree& octree, const SolverOptions& options,
                const std::function<void(const ShotStats&, const ProgressiveSolver&)>& on_shot,
-               const std::function<void(int done, int total)>& on_setup) {
+               const std::function<void(int done, int total)>& on_setup,
+               const std::function<void(int done, int total)>& on_transfer) {
     ProgressiveSolver solver(scene, octree, options, on_setup);
+    solver.on_transfer(on_transfer);
     while (!solver.done()) {
         const ShotStats shot = solver.shoot();
         if (on_shot) on_shot(shot, solver);

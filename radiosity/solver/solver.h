@@ -157,6 +157,10 @@ public:
     /// One shot: from the surface with the largest unshot power to every surface that can
     /// receive. Returns its statistics (also appended to solution().stats.per_shot).
     ShotStats shoot();
+    /// Called during each shot after every receiver's transfer, with the transfers done and
+    /// their total (for progress inside a long shot). Calls come one at a time, from whichever
+    /// thread finished the transfer; the function must not call back into the solver.
+    void on_transfer(std::function<void(int done, int total)> f) { on_transfer_ = std::move(f); }
     /// The fields so far.
     const Solution& solution() const { return solution_; }
     /// The fields so far, with run statistics filled (seconds, memory, coefficients).
@@ -170,6 +174,7 @@ private:
     const Scene& scene_;
     const Octree& octree_;
     SolverOptions options_;
+    std::function<void(int done, int total)> on_transfer_;
     /// Per surface the order m of its fields (surface_order: its own, else options.receiver.m).
     std::vector<int> order_;
     /// DN_m for every order m in use, built once (index m; null for an order no surface has).
@@ -224,10 +229,12 @@ private:
 };
 
 /// Solves the scene: shots until done(), calling on_shot (may be empty) after each.
-/// on_setup is passed to the solver (progress of the hidden regions).
+/// on_setup is passed to the solver (progress of the hidden regions), and on_transfer to its
+/// on_transfer (progress inside each shot).
 Solution solve(const Scene& scene, const Octree& octree, const SolverOptions& options,
                const std::function<void(const ShotStats&, const ProgressiveSolver&)>& on_shot = {},
-               const std::function<void(int done, int total)>& on_setup = {});
+               const std::function<void(int done, int total)>& on_setup = {},
+               const std::function<void(int done, int total)>& on_transfer = {});
 
 /// The projection of a surface's emission: constant coefficients for a constant texture, else
 /// the L2 projection at `level` (Gauss-Legendre quadrature of the texture against the basis,
