@@ -401,14 +401,14 @@ double percent_of_emitted(double power, const SolveStats& stats) {
 
 void print_shots(std::ostream& os, const Scene& scene, const SolveStats& stats) {
     Table t({"shot", "shooter", "shooter_power", "unshot_before_percent", "unshot_after_percent",
-             "receivers", "kernel_evals", "rays", "level", "seconds"});
+             "receivers", "kernel_evals", "analytic_evals", "rays", "level", "seconds"});
     for (const ShotStats& s : stats.per_shot)
-        t.add_row({std::to_string(s.shot), scene.surfaces[s.shooter].name,
-                   cell_g(s.shooter_power, 4),
-                   cell_g(percent_of_emitted(s.unshot_before, stats), 4),
-                   cell_g(percent_of_emitted(s.unshot_after, stats), 4),
-                   std::to_string(s.receivers), std::to_string(s.kernel_evals),
-                   std::to_string(s.rays), std::to_string(s.finest_level), cell(s.seconds, 3)});
+        t.add_row(
+            {std::to_string(s.shot), scene.surfaces[s.shooter].name, cell_g(s.shooter_power, 4),
+             cell_g(percent_of_emitted(s.unshot_before, stats), 4),
+             cell_g(percent_of_emitted(s.unshot_after, stats), 4), std::to_string(s.receivers),
+             std::to_string(s.kernel_evals), std::to_string(s.analytic_evals),
+             std::to_string(s.rays), std::to_string(s.finest_level), cell(s.seconds, 3)});
     t.write_text(os);
 }
 
@@ -435,7 +435,8 @@ void print_summary(std::ostream& os, const SceneRun& run, const SolveStats& st) 
        << "seconds " << cell(st.seconds, 3) << " (" << thread_count() << " threads), peak memory "
        << cell(double(st.peak_memory_bytes) / (1024.0 * 1024.0), 1) << " MiB, coefficients "
        << st.coefficients << " per channel\n"
-       << "kernel evaluations " << st.kernel_evals << ", shadow rays " << st.rays << "\n";
+       << "kernel evaluations " << st.kernel_evals << ", analytic form factors "
+       << st.analytic_evals << ", shadow rays " << st.rays << "\n";
 }
 
 double write_render(const SceneRun& run, const Solution& solution, const std::string& path,

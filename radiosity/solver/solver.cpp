@@ -603,6 +603,7 @@ void ProgressiveSolver::superpose(const std::vector<int>& receivers, std::vector
         solution_.radiosity[i].add(r.field);
         solution_.unshot[i].add(dB);
         shot.kernel_evals += r.stats.n_kernel_evals;
+        shot.analytic_evals += r.stats.n_analytic_evals;
         shot.rays += r.stats.n_rays;
         shot.finest_level = std::max(shot.finest_level, r.field.level());
         std::vector<std::uint64_t>& cells = split_cells_[i];
@@ -664,6 +665,7 @@ ShotStats ProgressiveSolver::shoot() {
     ++st.shots;
     st.unshot_power = shot.unshot_after;
     st.kernel_evals += shot.kernel_evals;
+    st.analytic_evals += shot.analytic_evals;
     st.rays += shot.rays;
     st.limited_power += shot.limited;
     st.per_shot.push_back(shot);

@@ -93,6 +93,7 @@ struct ShotStats {
     double incident = 0;       // power arriving: sum_i int dB_i A / rho_i (constant rho)
     int receivers = 0;         // transfers made
     long kernel_evals = 0;     // evaluations of (3) in all its transfers
+    long analytic_evals = 0;   // closed-form form factors (an emitter's analytic path)
     double limited = 0;        // power the limiter changed (clipping overshoots down: <= 0),
                                //   sum of channels
     long rays = 0;             // shadow rays
@@ -110,6 +111,7 @@ struct SolveStats {
     long peak_memory_bytes = 0;  // the process's peak resident memory
     long coefficients = 0;       // coefficients of the solved fields (all surfaces, per channel)
     long kernel_evals = 0, rays = 0;
+    long analytic_evals = 0;   // closed-form form factors (ShotStats::analytic_evals)
     double ambient_power = 0;  // power the ambient correction added (sum of channels)
     double limited_power = 0;  // the limiter's change of the reflected power, all shots (<= 0)
     std::vector<ShotStats> per_shot;

@@ -26,6 +26,12 @@ long IncrementSampler::n_rays() const {
     return n;
 }
 
+long IncrementSampler::n_analytic() const {
+    long n = 0;
+    for (const auto& integrator : integrators_) n += integrator->n_analytic();
+    return n;
+}
+
 Rgb IncrementSampler::sample(double s, double t, int thread, long* n_kernel_evals,
                              bool* converged) {
     // Eq. (21): dB_i(s,t) = rho_i(s,t) * int int F VIS B_h A_h du dv (at the nearest visible

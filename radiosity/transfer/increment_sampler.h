@@ -32,6 +32,9 @@ public:
     IncrementIntegrator& integrator(int thread) { return *integrators_[thread]; }
     /// Rays cast by the integrators' exact visibility so far (all threads).
     long n_rays() const;
+    /// Closed-form form factors the integrators computed so far (all threads;
+    /// IncrementIntegrator::n_analytic).
+    long n_analytic() const;
 
 private:
     const Shooter& shooter_;

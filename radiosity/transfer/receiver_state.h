@@ -131,6 +131,7 @@ struct ReceiverOptions {
 /// on the number of threads).
 struct TransferStats {
     long n_kernel_evals = 0;         // evaluations of F (3) inside the quadrature of (21)
+    long n_analytic_evals = 0;       // closed-form form factors instead of (or beside) them
     long n_increments = 0;           // evaluations of (21) (sample values)
     long n_oracle_increments = 0;    //   of which for the oracle
     long n_boundary_increments = 0;  //   of which for edgefill (values and divided differences)

@@ -51,6 +51,7 @@ double IncrementIntegrator::visible_form_factor(const SurfacePoint& p) {
     // The contour formula of the reference (Baum et al. 1989), piece by piece (each convex,
     // counter-clockwise seen from the shooter's front).
     if (view_.behind_all) return 0;
+    ++n_analytic_;
     std::vector<Vec3> polygon;
     auto lambert = [&](const ConvexPolygon& piece) {
         polygon.clear();

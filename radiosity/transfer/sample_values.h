@@ -190,6 +190,10 @@ public:
     Rgb shooter_radiosity(double u, double v) const;
     /// True when integrate() uses the closed form (QuadratureOptions::analytic).
     bool analytic() const { return analytic_; }
+    /// Closed-form form factors to the visible part of the shooter computed so far (the
+    /// analytic path of an emitter's shot and the singularity subtraction), counted apart from
+    /// kernel evaluations: each is one evaluation of the point-to-polygon formula.
+    long n_analytic() const { return n_analytic_; }
     /// Every receiving point lies on this plane (a planar receiver): the horizon is one line,
     /// and the points of the cells it cuts are cached like the others.
     void set_receiver_plane(const Plane& plane) { receiver_plane_ = plane; }
@@ -226,6 +230,7 @@ private:
     const OcclusionContext* occlusion_ = nullptr;  // exact visibility when set (and not clear)
     bool planar_ = false;                  // the shooter is a planar quad: exact clipping works
     bool analytic_ = false;                // and of constant radiosity: closed form
+    long n_analytic_ = 0;                  // visible_form_factor calls (n_analytic())
     ShooterPlane plane_;                   // its frame
     BlockedView view_;                     // what the current point cannot see
     std::vector<TriangleRule> tri_rules_;  // tri_rules_[n]

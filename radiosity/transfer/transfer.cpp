@@ -115,6 +115,7 @@ SplineField transfer(const Shooter& shooter, const ReceiverSurface& receiver,
         }
         state.mask = nullptr;  // it refers to the sampler, which ends here
         stats.n_rays += sampler.n_rays();
+        stats.n_analytic_evals += sampler.n_analytic();
     }
     state.stats.seconds_total = seconds_total;
     if (stats_out) *stats_out = state.stats;
