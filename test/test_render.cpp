@@ -246,6 +246,37 @@ TEST_CASE("render: a surface's back is culled by default, black on request", "[r
     for (const Rgb& px : seen.pixels) CHECK(px.r == Approx(1 / Pi));
 }
 
+TEST_CASE("render: the framing camera stands up the way the lights hang", "[render]") {
+    // The same open box turned so that z is up (the classic radiosity scenes' way): its light
+    // on the ceiling faces down (-z), so the camera's up is +z and it looks horizontally.
+    std::istringstream z_up(
+        "material white reflectance 0.5 0.5 0.5\n"
+        "material lamp reflectance 0 0 0 emission 5 5 5\n"
+        "rectangle floor   white 0 0 0  2 0 0  0 3 0\n"
+        "rectangle ceiling white 0 0 1  0 3 0  2 0 0\n"
+        "rectangle light   lamp  0.5 1 0.99  0 1 0  1 0 0\n"
+        "rectangle back    white 0 3 0  2 0 0  0 0 1\n");
+    const Scene scene = parse_scene(z_up, "z_up.scene");
+    CHECK(scene_up(scene) == Vec3{0, 0, 1});
+    const Camera c = framing_camera(scene);
+    CHECK(c.up == Vec3{0, 0, 1});
+    const Vec3 f = normalize(c.look_at - c.eye);
+    CHECK(f.z < 0);                        // a little from above
+    CHECK(std::abs(f.z) < 0.2);            // but nearly horizontal
+    CHECK(std::abs(f.y) > std::abs(f.x));  // through the open side y = 0, facing the back
+    CHECK(c.eye.y < 0);
+    // A light facing -x stands the camera on its side (up +x); a light that faces no axis
+    // (along 1 1 1) leaves up at y.
+    std::istringstream sideways(
+        "material lamp reflectance 0 0 0 emission 5 5 5\n"
+        "rectangle light lamp 0 0 0  0 0 1  0 1 0\n");
+    CHECK(scene_up(parse_scene(sideways, "s.scene")) == Vec3{1, 0, 0});
+    std::istringstream tilted(
+        "material lamp reflectance 0 0 0 emission 5 5 5\n"
+        "rectangle light lamp 0 0 0  1 -1 0  0 1 -1\n");
+    CHECK(scene_up(parse_scene(tilted, "t.scene")) == Vec3{0, 1, 0});
+}
+
 TEST_CASE("render: the framing camera sees a whole box from its open side", "[render]") {
     // A box [0, 2] x [0, 1] x [0, 3] of five inward faces, open at z = 0 (the Cornell box's
     // shape): the camera stands on the open side and every corner of the bounds is in view.

@@ -18,7 +18,7 @@ const char* reference_usage =
     "usage: mbr reference SCENE --points FILE.csv --paths N [--seed S] [--threads n]\n"
     "  Estimates the radiosity B at the points of FILE.csv by path tracing, independently of\n"
     "  mbr's solver, and prints name,B_r,B_g,B_b,se_r,se_g,se_b (se: standard errors).\n"
-    "  SCENE      a .scene file (or .obj with its .mtl)\n"
+    "  SCENE      a .scene file, an .obj with its .mtl, or an .mgf file\n"
     "  --points   CSV with a header naming columns name,x,y,z and optionally nx,ny,nz (the\n"
     "             normal of the face meant, where surfaces meet); each point must lie within\n"
     "             1e-3 of the scene's bounding-box diagonal of a surface\n"
@@ -62,7 +62,7 @@ int reference_command(Args& args) {
     options.threads = threads;
 
     const std::string& scene_path = positional[0];
-    const Scene scene = is_obj_path(scene_path) ? load_obj(scene_path) : load_scene(scene_path);
+    const Scene scene = load_scene_file(scene_path);
     print_scene_warnings(std::cerr, scene);
     const std::vector<ProbePoint> points = read_probe_points(points_path);
     const Octree octree = build_octree(scene);

@@ -25,10 +25,10 @@
 namespace mbr {
 
 std::string solver_options_usage() {
-    return "  SCENE                     a scene file (docs/scene-format.md) or a Wavefront OBJ\n"
-           "                            file (.obj in any case, with its MTL libraries)\n" +
+    return "  SCENE                     a scene file (docs/scene-format.md), a Wavefront OBJ file\n"
+           "                            (.obj, with its MTL libraries) or an MGF file (.mgf)\n" +
            option_usage() +
-           "  --strict                  refuse every fault of an imported OBJ, MTL or texture\n"
+           "  --strict                  refuse every fault of an imported OBJ, MTL, MGF or texture\n"
            "                            (default: repair it where the intent is clear, warn)\n"
            "  --light NAME[=E]          make material NAME, or the surfaces NAME and NAME.K,\n"
            "                            emit E (one number, or R,G,B; default: a mean radiosity\n"
@@ -193,10 +193,10 @@ void apply_light(Scene& scene, const std::string& value, const std::string& path
               << "\n";
 }
 
-/// Loads the scene or OBJ file at `path` (an OBJ by its extension in any case), applies
+/// Loads the scene, OBJ or MGF file at `path` (load_scene_file: by its extension), applies
 /// --light, and warns when nothing in it emits.
 Scene load_any_scene(const std::string& path, const SolverArgs& a) {
-    Scene scene = is_obj_path(path) ? load_obj(path, a.import) : load_scene(path, a.import);
+    Scene scene = load_scene_file(path, a.import);
     if (!a.light.empty()) apply_light(scene, a.light, path);
     if (a.two_sided_lights) {
         std::vector<int> lights;

@@ -316,7 +316,7 @@ int run(mbr::Args& args) {
     if (files.size() != 1) throw mbr::UsageError("expected one SCENE file");
 
     const std::string& path = files[0];
-    mbr::Scene scene = mbr::is_obj_path(path) ? mbr::load_obj(path) : mbr::load_scene(path);
+    mbr::Scene scene = mbr::load_scene_file(path);
     if (has_tessellation) scene.settings.tessellation = tessellation_option;
 
     mbr::ScenePolygonStats polygon_stats;

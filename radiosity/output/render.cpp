@@ -323,20 +323,50 @@ RenderStats& RenderStats::operator+=(const RenderStats& other) {
     return *this;
 }
 
+Vec3 scene_up(const Scene& scene) {
+    // The lights' mean normal, weighted by their power (area x the emission's mean channel).
+    Vec3 down;
+    for (const SceneSurface& s : scene.surfaces) {
+        const Material& m = scene.materials[size_t(s.material)];
+        if (!m.emits()) continue;
+        const Rgb e = m.emission.mean();
+        const double power = (e.r + e.g + e.b) / 3;
+        for (int a = 0; a < 4; ++a)
+            for (int b = 0; b < 4; ++b) {
+                const SurfacePoint p = s.surface.evaluate((a + 0.5) / 4, (b + 0.5) / 4);
+                down += (power * p.area_factor / 16) * p.normal;
+            }
+    }
+    int axis = 0;
+    for (int k = 1; k < 3; ++k)
+        if (std::fabs(down[k]) > std::fabs(down[axis])) axis = k;
+    if (!(length(down) > 0) || std::fabs(down[axis]) < 0.7 * length(down)) return {0, 1, 0};
+    Vec3 up;
+    up[axis] = down[axis] > 0 ? -1 : 1;
+    return up;
+}
+
 Camera framing_camera(const Scene& scene) {
     Camera c;
     c.fov_degrees = 45;
     c.width = 640;
     c.height = 480;
-    c.up = {0, 1, 0};
+    c.up = scene_up(scene);
     const Box3 bounds = scene.bounds();
     const Vec3 centre = bounds.empty() ? Vec3{0, 0, 0} : bounds.centre();
     const double r = bounds.empty() ? 0 : 0.5 * length(bounds.extent());
     const double radius = r > 0 ? r : 1;  // a point or nothing: a unit sphere around it
     const double distance = 1.05 * radius / std::sin(0.5 * c.fov_degrees * Pi / 180);
     // The four sides, each a horizontal axis raised by 0.15 (from straight ahead both side
-    // walls of a box face the eye; a little above, its floor shows).
-    const Vec3 sides[4] = {{0, 0.15, 1}, {0, 0.15, -1}, {1, 0.15, 0}, {-1, 0.15, 0}};
+    // walls of a box face the eye; a little above, its floor shows). With up the y axis they
+    // are +z, -z, +x, -x; with up axis k, the axes k + 2 and k + 1 (mod 3) likewise.
+    int k = 0;
+    while (c.up[k] == 0) ++k;
+    Vec3 h1, h2;
+    h1[(k + 2) % 3] = 1;
+    h2[(k + 1) % 3] = 1;
+    const Vec3 raise = 0.15 * c.up;
+    const Vec3 sides[4] = {h1 + raise, -1.0 * h1 + raise, h2 + raise, -1.0 * h2 + raise};
     Vec3 best = normalize(sides[0]);
     double best_facing = -HUGE_VAL;
     for (const Vec3& side : sides) {

@@ -51,12 +51,19 @@ struct RenderStats {
 /// stb's PNG encoding, and with the quadtree overlay the surface and leaf seen at each pixel.
 double render_bytes(int width, int height, const RenderOptions& options = {});
 
+/// The up direction of a scene without a camera: lights hang from ceilings, so up is the
+/// coordinate axis opposite the lights' mean normal (weighted by area and mean emission) when
+/// that normal lies within about 45 degrees of an axis (its largest component at least 0.7 of
+/// its length); otherwise, and without lights, (0, 1, 0), the OBJ convention.
+Vec3 scene_up(const Scene& scene);
+
 /// The camera a scene without a camera statement is rendered from (docs/scene-format.md,
-/// "camera"): it looks at the centre c of the scene's bounds from one of four sides (+z, -z, +x,
-/// -x, each direction d raised by 0.15), the side the scene's
+/// "camera"): up is scene_up; it looks at the centre c of the scene's bounds from one of four
+/// horizontal sides (with up y: +z, -z, +x, -x; with up axis k: the axes k + 2, k + 1 mod 3,
+/// each way; each direction d raised by 0.15 along up), the side the scene's
 /// surfaces face most on balance (the sum of area x n . d over a 4 x 4 grid of each surface: a
 /// box open on one side is seen through its opening; a closed room ties, and ties go to the
-/// first), up (0, 1, 0), a vertical field of view of 45 degrees and 640 x 480 pixels,
+/// first), a vertical field of view of 45 degrees and 640 x 480 pixels,
 /// from the distance at which the bounds' sphere (radius r, half the diagonal) fits the field
 /// of view with 5 % to spare: 1.05 r / sin(22.5 degrees). With back faces culled (the default)
 /// the walls between it and the inside of a room are not drawn.

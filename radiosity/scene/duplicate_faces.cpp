@@ -11,7 +11,7 @@
 #include <tuple>
 
 #include "math/check.h"
-#include "radiosity/scene/obj_reader.h"
+#include "radiosity/scene/mgf_reader.h"
 
 namespace mbr {
 
@@ -232,7 +232,7 @@ void drop_duplicate_surfaces(Scene& scene, const ImportOptions& options) {
     };
     std::vector<int> other_material;
     for (const DuplicateSurface& d : repeats)
-        if (!same_material(d) && !options.strict && is_obj_path(file_of(d.later))) {
+        if (!same_material(d) && !options.strict && is_import_path(file_of(d.later))) {
             if (other_material.empty()) {
                 SceneWarning w;
                 w.kind = "duplicate surface with another material";

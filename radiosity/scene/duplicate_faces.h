@@ -48,8 +48,8 @@ std::vector<DuplicateSurface> find_duplicate_surfaces(const Scene& scene);
 /// of repeated statements); a repeat with another material is an InputError at its statement's
 /// file:line naming both statements and both materials, raised before anything is dropped.
 /// Surfaces that coincide but face opposite ways (a two-sided wall) are both kept. In a
-/// forgiving import (options.strict off) a repeat with another material read from an OBJ file
-/// is dropped instead, with one warning of kind "duplicate surface with another material".
+/// forgiving import (options.strict off) a repeat with another material read from an OBJ or MGF
+/// file is dropped instead, with one warning of kind "duplicate surface with another material".
 /// Copies of one material made for texture coordinates (MATERIAL@LINE.K) count as the same.
 void drop_duplicate_surfaces(Scene& scene, const ImportOptions& options = {});
 

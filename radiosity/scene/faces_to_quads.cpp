@@ -87,8 +87,14 @@ bool is_simple(const std::vector<Vec2>& q) {
 }
 
 /// Ear clipping in the plane normal to n, choosing the ear with the shortest new diagonal.
-/// Returns false when no ear exists. Expects a simple polygon (is_simple).
+/// Returns false when no ear exists. Expects a simple polygon (is_simple) or a weakly simple one:
+/// a face with holes joined to its outline along seams, each seam an edge walked there and back
+/// (MGF writes holes so; docs/scene-format.md, "MGF import"). A vertex that coincides with one of
+/// the ear's corners (the other end of a seam) does not block the ear; the caller checks the result
+/// covers the face's net area once (covers_net_area).
 bool triangulate(std::vector<Vec3> p, Vec3 n, std::vector<std::array<Vec3, 3>>& triangles) {
+    const double size = max_pairwise_distance(p);
+    auto same = [&](size_t j, size_t k) { return length(p[j] - p[k]) <= 1e-9 * size; };
     std::vector<Vec2> q = project(p, n);
     auto inside = [](Vec2 a, Vec2 b, Vec2 c, Vec2 x) {
         // Closed triangle test (points on the edges count as inside, which blocks the ear).
@@ -104,7 +110,8 @@ bool triangulate(std::vector<Vec3> p, Vec3 n, std::vector<std::array<Vec3, 3>>& 
             if (!(turn > 1e-12 * scale)) continue;  // reflex or straight: not an ear
             bool blocked = false;
             for (size_t j = 0; j < k && !blocked; ++j)
-                if (j != a && j != i && j != c) blocked = inside(q[a], q[i], q[c], q[j]);
+                if (j != a && j != i && j != c && !same(j, a) && !same(j, i) && !same(j, c))
+                    blocked = inside(q[a], q[i], q[c], q[j]);
             if (blocked) continue;
             double len = length(p[c] - p[a]);
             if (len < best_len) {
@@ -120,6 +127,16 @@ bool triangulate(std::vector<Vec3> p, Vec3 n, std::vector<std::array<Vec3, 3>>& 
     }
     triangles.push_back({p[0], p[1], p[2]});
     return true;
+}
+
+/// True when the triangles' areas add up to the net area of the polygon with unit normal n
+/// (Newell's vector `newell`, twice the area vector): a triangulation of a simple or weakly
+/// simple face covers it once, while ears cut from a face whose edges cross overlap or stick out.
+bool covers_net_area(const std::vector<std::array<Vec3, 3>>& triangles, Vec3 newell, Vec3 n) {
+    double sum = 0;
+    for (const auto& t : triangles) sum += std::fabs(dot(cross(t[1] - t[0], t[2] - t[0]), n));
+    const double net = dot(newell, n);
+    return std::fabs(sum - net) <= 1e-7 * std::fabs(net);
 }
 
 /// face_to_quads for a face given relative to one of its vertices.
@@ -146,10 +163,10 @@ std::vector<Quad> local_face_to_quads(const Line& line, std::vector<Vec3> p) {
         }
     }
     if (p.size() < 3) line.fail("degenerate face: zero area (its vertices are collinear)");
-    Vec3 n = newell_normal(p);
-    if (length(n) <= 1e-9 * size * size)
+    const Vec3 newell = newell_normal(p);
+    if (length(newell) <= 1e-9 * size * size)
         line.fail("degenerate face: zero net area (it intersects itself)");
-    n = normalize(n);
+    const Vec3 n = normalize(newell);
 
     std::vector<Quad> quads;
     if (p.size() == 3) {
@@ -188,7 +205,10 @@ std::vector<Quad> local_face_to_quads(const Line& line, std::vector<Vec3> p) {
         }
     }
     std::vector<std::array<Vec3, 3>> triangles;
-    if (!is_simple(project(p, n)) || !triangulate(p, n, triangles))
+    // A face whose edges touch may still be weakly simple (holes joined along seams): its ears
+    // must then cover its net area exactly once.
+    const bool simple = is_simple(project(p, n));
+    if (!triangulate(p, n, triangles) || (!simple && !covers_net_area(triangles, newell, n)))
         line.fail("face of " + std::to_string(p.size()) +
                   " vertices intersects itself (it cannot be triangulated)");
     for (const auto& t : triangles)

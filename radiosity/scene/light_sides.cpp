@@ -7,7 +7,7 @@
 #include <unordered_set>
 
 #include "radiosity/scene/line_reader.h"
-#include "radiosity/scene/obj_reader.h"
+#include "radiosity/scene/mgf_reader.h"
 #include "radiosity/scene/scene_octree.h"
 
 namespace mbr {
@@ -94,7 +94,7 @@ void face_lights_to_the_open_side(Scene& scene, const ImportOptions& options) {
         const SceneSurface& s = scene.surfaces[i];
         const Material& m = scene.materials[size_t(s.material)];
         const bool from_obj = s.source >= 0 && size_t(s.source) < scene.sources.size() &&
-                              is_obj_path(scene.sources[size_t(s.source)]);
+                              is_import_path(scene.sources[size_t(s.source)]);
         if (from_obj && m.emits() && !m.two_sided) candidates.push_back(int(i));
     }
     const std::vector<BackFacingLight> lights = find_back_facing_lights(scene, candidates);

@@ -36,10 +36,10 @@ std::vector<BackFacingLight> find_back_facing_lights(const Scene& scene,
                                                      const std::vector<int>& candidates);
 
 /// The forgiving import's repair of back-facing lights (ImportOptions): every emitter read
-/// from an OBJ file that find_back_facing_lights names, with a constant emission and
-/// reflectance (a texture would be mirrored), is turned around (Surface::reversed), with one
-/// warning of kind "light turned around" for the load. Strict, the lights stay as they are and
-/// the warning says so ("light faces away").
+/// from an OBJ or MGF file (is_import_path) that find_back_facing_lights names, with a constant
+/// emission and reflectance (a texture would be mirrored), is turned around (Surface::reversed),
+/// with one warning of kind "light turned around" for the load. Strict, the lights stay as they are
+/// and the warning says so ("light faces away").
 void face_lights_to_the_open_side(Scene& scene, const ImportOptions& options);
 
 }  // namespace mbr

@@ -161,7 +161,7 @@ public:
                            w.message + ")";
             throw InputError(name_, 0, why);
         }
-        name_surfaces();
+        number_surface_names(scene_);
         scene_.input_files = state_.files();
         return std::move(scene_);
     }
@@ -388,26 +388,6 @@ private:
         mat.reflectance = Texture::constant({0.5, 0.5, 0.5});
         scene_.materials.push_back(mat);
         return int(scene_.materials.size()) - 1;
-    }
-
-    /// A group that yields one surface gives it its own name; the surfaces of a group that
-    /// yields several are NAME.0, NAME.1, ... in file order, skipping every number whose name is
-    /// already taken (by a group of that name, say `a.0` next to a group `a` of two faces), so
-    /// that every name is unique.
-    void name_surfaces() {
-        std::unordered_map<std::string, int> count, next;
-        for (const SceneSurface& s : scene_.surfaces) ++count[s.name];
-        std::unordered_set<std::string> taken;
-        for (const auto& [name, n] : count)
-            if (n == 1) taken.insert(name);
-        for (SceneSurface& s : scene_.surfaces) {
-            if (count[s.name] == 1) continue;
-            int& k = next[s.name];
-            std::string numbered;
-            do numbered = s.name + "." + std::to_string(k++);
-            while (!taken.insert(numbered).second);
-            s.name = std::move(numbered);
-        }
     }
 
     /// `mtllib FILE`: the library beside the OBJ file, or (forgiving) wherever locate() finds
@@ -644,6 +624,22 @@ void LoadState::charge(const Line& line) {
     if (++n_files_ > max_files_read)
         line.fail("more than " + std::to_string(max_files_read) +
                   " files are read by this scene (includes, OBJ, MTL, textures)");
+}
+
+void number_surface_names(Scene& scene) {
+    std::unordered_map<std::string, int> count, next;
+    for (const SceneSurface& s : scene.surfaces) ++count[s.name];
+    std::unordered_set<std::string> taken;
+    for (const auto& [name, n] : count)
+        if (n == 1) taken.insert(name);
+    for (SceneSurface& s : scene.surfaces) {
+        if (count[s.name] == 1) continue;
+        int& k = next[s.name];
+        std::string numbered;
+        do numbered = s.name + "." + std::to_string(k++);
+        while (!taken.insert(numbered).second);
+        s.name = std::move(numbered);
+    }
 }
 
 Texture LoadState::image(const Line& line, const std::string& path) {

@@ -3,6 +3,7 @@
 // and emission E of eq. (1). Every bad input becomes one InputError naming the file and line.
 #pragma once
 
+#include <algorithm>
 #include <iosfwd>
 #include <string>
 #include <unordered_map>
@@ -45,8 +46,10 @@ public:
     /// Counts one more file read on behalf of `line` (at most 1000 per load).
     void charge(const Line& line);
 
-    /// Records that the file at `path` was opened (Scene::input_files).
-    void record(const std::string& path) { files_.push_back(path); }
+    /// Records that the file at `path` was opened (Scene::input_files), once however often.
+    void record(const std::string& path) {
+        if (std::find(files_.begin(), files_.end(), path) == files_.end()) files_.push_back(path);
+    }
 
     /// The files recorded so far, in the order opened.
     const std::vector<std::string>& files() const { return files_; }
@@ -62,6 +65,12 @@ private:
     std::vector<std::string> files_;                     // paths opened, in order
     std::unordered_map<std::string, Texture> textures_;  // canonical path -> decoded image
 };
+
+/// Names the surfaces of an import uniquely: a group (an OBJ group, an MGF object) that yields
+/// one surface gives it its own name; the surfaces of a group that yields several are NAME.0,
+/// NAME.1, ... in file order, skipping every number whose name is already taken (by a group of
+/// that name, say `a.0` next to a group `a` of two faces).
+void number_surface_names(Scene& scene);
 
 /// Reads OBJ text named `name` as part of the load `state` (parse_obj with a shared state),
 /// without the check for repeated faces, which the caller runs once on the whole scene.

@@ -16,6 +16,7 @@
 #include "radiosity/scene/faces_to_quads.h"
 #include "radiosity/scene/light_sides.h"
 #include "radiosity/scene/line_reader.h"
+#include "radiosity/scene/mgf_reader.h"
 #include "radiosity/scene/obj_reader.h"
 #include "radiosity/scene/settings.h"
 
@@ -223,14 +224,14 @@ private:
             camera(line);
         } else if (key == "set") {
             setting(line);
-        } else if (key == "obj") {
-            obj(line);
+        } else if (key == "obj" || key == "mgf") {
+            import(line);
         } else if (key == "include") {
             include(line, depth);
         } else {
             line.fail("unknown keyword " + in_quotes(key) +
                       " (expected material, quad, bilinear, rectangle, box, cylinder, sphere, "
-                      "disk, camera, set, obj or include)");
+                      "disk, camera, set, obj, mgf or include)");
         }
     }
 
@@ -600,22 +601,24 @@ private:
         if (key == "min_depth" || key == "max_depth") depth_line_ = line;
     }
 
-    // --- obj FILE [order M], include FILE
+    // --- obj FILE [order M], mgf FILE [order M], include FILE
 
-    void obj(const Line& line) {
-        if (line.size() < 2) line.fail("'obj' needs one file name");
+    void import(const Line& line) {
+        const bool mgf = line[0] == "mgf";
+        const std::string kind = mgf ? "MGF" : "OBJ";
+        if (line.size() < 2) line.fail(in_quotes(line[0]) + " needs one file name");
         // `order M` gives every surface of the import that order (SceneSurface::order).
-        const SurfaceWords words = trailing_words(line, 2, false, "the OBJ file's name");
+        const SurfaceWords words = trailing_words(line, 2, false, "the " + kind + " file's name");
         if (words.end != 2)
-            line.fail("unknown word " + in_quotes(line[2]) +
-                      " after the OBJ file's name (only 'order M' may follow)");
+            line.fail("unknown word " + in_quotes(line[2]) + " after the " + kind +
+                      " file's name (only 'order M' may follow)");
         std::string path = resolve(line.file, line[1]);
         state_.charge(line);
         std::ifstream in;
-        open_named(line, "OBJ file", path, in);
+        open_named(line, kind + " file", path, in);
         state_.record(path);
-        Scene part = read_obj(in, path, state_);
-        // Merge: the OBJ's materials join the scene's (names must be new, except the shared
+        Scene part = mgf ? read_mgf(in, path, state_) : read_obj(in, path, state_);
+        // Merge: the import's materials join the scene's (names must be new, except the shared
         // default material), then its surfaces with their material indices moved along.
         std::vector<int> index(part.materials.size());
         for (size_t i = 0; i < part.materials.size(); ++i) {
