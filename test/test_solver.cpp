@@ -594,3 +594,36 @@ TEST_CASE("solver: a floor of 1e8 under a 1 x 1 lamp gives a finite solution", "
     CHECK(solution.radiosity[size_t(scene.find_surface("light"))].evaluate(0.5, 0.5).r ==
           Approx(1));
 }
+
+TEST_CASE("hidden regions: texels no smaller than 1/2048 of the scene, 4 to 64 a side",
+          "[solver][hidden]") {
+    CHECK(hidden_texels(1, 1) == 64);
+    CHECK(hidden_texels(64.0 / 2048, 1) == 64);
+    CHECK(hidden_texels(10.5 / 2048, 1) == 11);
+    CHECK(hidden_texels(1e-9, 1) == 4);
+    CHECK(hidden_texels(0, 1) == 64);  // a degenerate size leaves the full grid
+    // The example scenes' surfaces are all large enough for the full 64 x 64 grid, so their
+    // solutions are those of the fixed grid.
+    for (const char* name : {"cornell_box.scene", "room.scene"}) {
+        const Scene scene = load_scene(std::string(MBR_SOURCE_DIR) + "/examples/scenes/" + name);
+        const double diagonal = length(scene.bounds().extent());
+        for (const SceneSurface& s : scene.surfaces) {
+            CAPTURE(name, s.name);
+            CHECK(hidden_texels(length(s.surface.bounds().extent()), diagonal) == 64);
+        }
+    }
+    // A small box on a big floor: the floor keeps 64 texels a side, the box's faces fewer.
+    std::istringstream in(
+        "material white reflectance 0.5 0.5 0.5\n"
+        "rectangle floor white -50 0 -50  0 0 100  100 0 0\n"
+        "box block white 0 0 0  0.2 0.2 0.2\n");
+    const Scene scene = parse_scene(in, "small_box.scene");
+    const Octree octree = build_octree(scene);
+    const HiddenMask floor = find_hidden(scene.surfaces[0].surface, 0, octree);
+    CHECK(floor.resolution() == 64);
+    for (size_t i = 1; i < scene.surfaces.size(); ++i) {
+        const HiddenMask face = find_hidden(scene.surfaces[i].surface, int(i), octree);
+        CHECK(face.resolution() < 64);
+        CHECK(face.resolution() >= 4);
+    }
+}

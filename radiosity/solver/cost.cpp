@@ -29,9 +29,10 @@ constexpr double bytes_per_sample = sizeof(Rgb);
 // Calibration of the time: the same runs took 3.7 s at d = 7 and 12.8 s at d = 8 of wall time on
 // two busy cores, ~2e-4 s a leaf. A rough figure for a warning, nothing more.
 constexpr double seconds_per_leaf = 2e-4;
-// The hidden regions before the first shot (find_hidden, 64^2 texels of 4 to 16 rays), CPU
-// seconds a surface: 0.68 s for the room's 27 surfaces (25 ms), 7.2 s for 505 tiles of
-// scene_scaling (14 ms), user time of `mbr probe SCENE --max-shots 0`.
+// The hidden regions before the first shot (find_hidden, up to 64^2 texels of 4 to 16 rays),
+// CPU seconds a surface of the full 64^2: 0.68 s for the room's 27 surfaces (25 ms), 7.2 s for
+// 505 tiles of scene_scaling (14 ms), user time of `mbr probe SCENE --max-shots 0`; a surface of
+// fewer texels (hidden_texels) in proportion.
 constexpr double hidden_seconds_per_surface = 0.025;
 
 // Calibration of the polygons (octree_stats examples/scenes/room.scene --tessellation T
@@ -117,9 +118,13 @@ CostEstimate scene_cost(const Scene& scene, const SolverOptions& options, int th
     const double caches = double(std::max(1, threads)) * cached_points_bytes();
     // Per surface: its hidden-region mask (a byte and a substitute point per texel), and a row
     // of the measured coupling for every shooter that has shot (at most max_shots rows).
-    const double hidden = options.hidden_regions ? n_surfaces * hidden_resolution *
-                                                       hidden_resolution * (1.0 + sizeof(Vec2))
-                                                 : 0.0;
+    double texels = 0;  // of every surface's mask (hidden_texels a side)
+    const double diagonal = length(scene.bounds().extent());
+    for (const SceneSurface& s : scene.surfaces) {
+        const double n = hidden_texels(length(s.surface.bounds().extent()), diagonal);
+        texels += n * n;
+    }
+    const double hidden = options.hidden_regions ? texels * (1.0 + sizeof(Vec2)) : 0.0;
     const double coupling =
         std::min(double(std::max(0, options.max_shots)), n_surfaces) * n_surfaces * sizeof(Rgb);
     fields += coupling;
@@ -136,7 +141,9 @@ CostEstimate scene_cost(const Scene& scene, const SolverOptions& options, int th
     CostEstimate c;
     c.bytes =
         program_bytes + fields + hidden + transfers + caches + polygons + textures + occluder_lists;
-    c.setup_seconds = options.hidden_regions ? n_surfaces * hidden_seconds_per_surface : 0.0;
+    c.setup_seconds = options.hidden_regions ? texels / (hidden_resolution * hidden_resolution) *
+                                                   hidden_seconds_per_surface
+                                             : 0.0;
     c.seconds = c.setup_seconds + seconds;
     c.detail = "program " + format_bytes(program_bytes) + ", fields " + format_bytes(fields) +
                ", hidden regions " + format_bytes(hidden) + ", transfers " +

@@ -40,6 +40,16 @@ SampledField sample_field(const SplineField& field, int q) {
 void lift_to_bound(SplineField& field, Rgb bound, double side, int q, double slack) {
     const int m = field.order(), cells = 1 << field.level();
     const auto g_of = [&](int c, double a) { return side * (a - bound[c]); };
+    // With no negative coefficient of g, g >= 0 everywhere (the B-splines are non-negative):
+    // nothing to sample (most fields of a big scene, which would otherwise cost two grids).
+    bool any_negative = false;
+    for (int c = 0; c < 3 && !any_negative; ++c)
+        for (double a : field.channel(c).a)
+            if (g_of(c, a) < 0) {
+                any_negative = true;
+                break;
+            }
+    if (!any_negative) return;
     SplineField positive = field, negative = field;
     for (int c = 0; c < 3; ++c) {
         for (double& a : positive.channel(c).a) a = std::max(g_of(c, a), 0.0);

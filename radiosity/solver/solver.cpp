@@ -712,12 +712,29 @@ std::vector<Rgb> ProgressiveSolver::ambient_correction() const {
         const double f = i == j || others[j] <= 0 ? 0.0 : area[i] / others[j];
         return {f, f, f};
     };
-    std::vector<Rgb> X = U, gain(n);
+    // A surface that never shot sends area_i / others_j of X_j to every other surface i: its
+    // part of what reaches i is area_i times the sum over the other such j of X_j / others_j,
+    // taken for every i at once from prefix and suffix sums (linear in the surfaces, and no
+    // subtraction of i's own term to cancel). Only the surfaces that shot have a row of their
+    // own to visit.
+    std::vector<int> shot;
+    for (int j = 0; j < n; ++j)
+        if (!coupling_[j].empty()) shot.push_back(j);
+    std::vector<Rgb> X = U, gain(n), spread_before(n), spread_after(n);
     for (int iteration = 0; iteration < 1000; ++iteration) {
         double change = 0, size = 0;
+        Rgb before, after;
+        for (int j = 0; j < n; ++j) {
+            spread_before[j] = before;
+            if (coupling_[j].empty() && others[j] > 0) before += (1 / others[j]) * X[j];
+        }
+        for (int j = n - 1; j >= 0; --j) {
+            spread_after[j] = after;
+            if (coupling_[j].empty() && others[j] > 0) after += (1 / others[j]) * X[j];
+        }
         for (int i = 0; i < n; ++i) {
-            Rgb arriving;
-            for (int j = 0; j < n; ++j) arriving += coupling(j, i) * X[j];
+            Rgb arriving = area[i] * (spread_before[i] + spread_after[i]);
+            for (int j : shot) arriving += coupling(j, i) * X[j];
             gain[i] = rho[i] * arriving;
         }
         for (int i = 0; i < n; ++i) {

@@ -65,10 +65,16 @@ Vec2 HiddenMask::substitute(double s, double t) const {
     return hidden_[k] ? substitute_[k] : Vec2{s, t};
 }
 
+int hidden_texels(double size, double scene_size) {
+    if (!(size > 0) || !(scene_size > 0)) return hidden_resolution;
+    const double texels = std::ceil(size / (hidden_min_texel * scene_size));
+    return int(std::clamp(texels, double(hidden_min_resolution), double(hidden_resolution)));
+}
+
 HiddenMask find_hidden(const Surface& surface, int surface_id, const Octree& octree) {
-    const int n = hidden_resolution;
     const Box3 box = octree.bounds();
     const double scale = box.empty() ? 1.0 : length(box.extent());
+    const int n = hidden_texels(length(surface.bounds().extent()), scale);
     std::vector<std::uint8_t> hidden(size_t(n) * n, 0);
     parallel_for(n * n, [&](int k) {
         const int i = k % n, j = k / n;

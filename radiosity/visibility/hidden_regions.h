@@ -42,13 +42,25 @@ private:
 };
 
 /// The hidden-region test's constants.
-constexpr int hidden_resolution = 64;      // texels along each parameter direction
-constexpr int hidden_rays = 16;            // cosine-distributed rays per texel centre
+constexpr int hidden_resolution = 64;            // texels along each parameter direction, at most
+constexpr int hidden_min_resolution = 4;         //   and at least
+constexpr double hidden_min_texel = 1.0 / 2048;  // a texel's least size, over the scene's
+                                                 //   diagonal
+constexpr int hidden_rays = 16;                  // cosine-distributed rays per texel centre
 constexpr double hidden_back_share = 0.9;  // hidden when at least this share of the rays hit a
                                            //   back face
 
+/// The texels along each direction of the mask of a surface whose bounding box's diagonal is
+/// `size` in a scene of diagonal `scene_size`: 64, or fewer for a surface so small that its
+/// texels would be smaller than 1/2048 of the scene (at least 4). DESIGN: the test's cost then
+/// follows the scene's area rather than its count of surfaces (a chair's leg among 9,804
+/// surfaces no longer costs 64 x 64 texels), while the Cornell box's and the room's surfaces,
+/// all larger than 64 such texels (the room's fruit and stool legs too), keep their 64 x 64.
+int hidden_texels(double size, double scene_size);
+
 /// The mask of `surface` (its index in the octree's polygons' surface ids is `surface_id`):
-/// from each texel centre, rays over the hemisphere in front; a ray that meets a polygon's
+/// hidden_texels x hidden_texels texels; from each texel centre, rays over the hemisphere in
+/// front; a ray that meets a polygon's
 /// back before anything else counts as hidden, one that meets a front face or leaves the scene
 /// as visible. A texel is tested with 4 rays first and the rest only when all 4 were hidden.
 /// Rays are seeded from the surface and the texel (reproducible, thread-count independent).
