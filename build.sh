@@ -2,6 +2,7 @@
 # build.sh - the thin wrapper behind README's two commands (and CI's sanitizer run).
 #   ./build.sh main       install what is missing, build (Release, build/), run the main job
 #   ./build.sh test       install what is missing, build (build/), run every test through CTest
+#                         (with the glTF validator's npm package in build/npm when npm is there)
 #   ./build.sh sanitize   the same tests built with -DMBR_SANITIZE=ON in build-sanitize/
 #   ./build.sh gallery    build, then regenerate the README's pictures in docs/images/
 set -euo pipefail
@@ -22,6 +23,21 @@ install_missing() {
         $sudo apt-get update
         $sudo apt-get install -y "${missing[@]}"
     fi
+}
+
+# The Khronos glTF validator (npm package gltf-validator) for the CTest test gltf_validator
+# (test/validate_export.sh), installed into DIR/npm when node and npm exist and it is not there
+# yet. A failure is tolerated: the test is then reported as skipped.
+install_gltf_validator() {  # dir
+    local dir=$1
+    [ -d "$dir/npm/node_modules/gltf-validator" ] && return 0
+    if ! command -v node >/dev/null 2>&1 || ! command -v npm >/dev/null 2>&1; then
+        echo "build.sh: node or npm is missing: the glTF validator test will be skipped"
+        return 0
+    fi
+    mkdir -p "$dir/npm"
+    npm install --prefix "$dir/npm" --no-audit --no-fund gltf-validator ||
+        echo "build.sh: npm could not install gltf-validator: the glTF validator test will be skipped"
 }
 
 configure_and_build() {  # dir, extra cmake arguments...
@@ -86,6 +102,7 @@ case "${1:-}" in
     test)
         install_missing
         configure_and_build build
+        install_gltf_validator build
         (cd build && ctest --output-on-failure -j "$jobs")
         ;;
     gallery)
@@ -96,6 +113,7 @@ case "${1:-}" in
     sanitize)
         install_missing
         configure_and_build build-sanitize -DMBR_SANITIZE=ON
+        install_gltf_validator build-sanitize
         (cd build-sanitize && ctest --output-on-failure -j "$jobs")
         ;;
     *)

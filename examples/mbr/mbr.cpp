@@ -1,11 +1,13 @@
 // examples/mbr/mbr.cpp - the mbr command-line tool: solve a scene by multiresolution B-spline
-// radiosity (paper sections 4-6) and render it, print the paper's tables, or read the solved
-// radiosity (or an independent path-traced estimate) at chosen points.
+// radiosity (paper sections 4-6) and render it or export it for viewers, print the paper's
+// tables, or read the solved radiosity (or an independent path-traced estimate) at chosen points.
 //
 //   mbr render SCENE -o OUT.png [options]     solve (or load) and render to PNG (and HDR)
 //   mbr probe SCENE --points FILE.csv         solve (or load), then B at the points, as CSV
 //     both with --light-group NAME=WEIGHT ... [--group-solutions PREFIX]: relighting, the
 //     weighted sum of each light group's solution (radiosity/solver/superposition.h)
+//   mbr export SCENE -o OUT.glb|OUT.ply       solve (or load), then the lit surfaces as a mesh
+//                                             (glTF 2.0 binary or PLY) for viewers
 //   mbr reference SCENE --points FILE.csv --paths N   path-traced B at the points
 //   mbr tables                                Tables 1, 2 and 3 beside the paper's values
 //   mbr --help | mbr COMMAND --help | mbr --version
@@ -32,6 +34,7 @@
 #include "examples/common/scene_cli.h"
 #include "examples/common/transfer_cli.h"
 #include "math/check.h"
+#include "radiosity/output/export.h"
 #include "radiosity/output/output_file.h"
 #include "radiosity/output/render.h"
 #include "radiosity/reference/probe.h"
@@ -53,6 +56,9 @@ const char* main_usage =
     "    --light-group NAME=WEIGHT ... [--group-solutions PREFIX]: relight, a weighted sum\n"
     "    of the light groups' solutions, without solving again (mbr render --help)\n"
     "  probe SCENE --points F.csv  solve (or load), then print B at the given world points\n"
+    "  export SCENE -o OUT.glb|OUT.ply\n"
+    "                              solve (or load), then write the lit surfaces as a glTF 2.0\n"
+    "                              binary or PLY mesh for viewers (Blender, three.js)\n"
     "  reference SCENE --points F.csv --paths N\n"
     "                              an independent path-traced estimate at those points\n"
     "  tables                      the paper's Tables 1, 2 and 3, computed now, beside its values\n"
@@ -127,6 +133,31 @@ std::string probe_usage() {
                "  --save-solution F         write the solved fields to F (for render or probe\n"
                "                            --load-solution)\n") +
            light_group_usage(false) + solver_options_usage();
+}
+
+std::string export_usage() {
+    return std::string(
+               "usage: mbr export SCENE -o OUT.glb|OUT.ply [--lightmaps SIZE] [--exposure x]\n"
+               "                  [--load-solution F | --save-solution F] [options]\n"
+               "  Solves SCENE (or loads a solution) and writes every surface as a triangle mesh\n"
+               "  with its radiosity at the vertices, for viewers: radiosity does not depend on\n"
+               "  the view, so the lit scene can be looked at from anywhere (docs/export.md).\n"
+               "  Each surface is a regular grid of its (u, v) domain, twice as fine as its\n"
+               "  field's knots (curved ones at least the scene's tessellation; at most 256).\n"
+               "  -o OUT.glb|OUT.ply        the file (required); its extension, in any case, says\n"
+               "                            the format: glTF 2.0 binary (one unlit mesh per\n"
+               "                            surface, COLOR_0 = min(1, exposure B/pi), the exact B\n"
+               "                            as _RADIOSITY) or binary PLY (8-bit sRGB colours as\n"
+               "                            mbr render's pixels, and float radiosity_r/g/b = B)\n"
+               "  --exposure x              radiance multiplier of the colours, as render's\n"
+               "                            (default 1); B itself is written unscaled\n"
+               "  --lightmaps SIZE          .glb only: also bake every surface's B into one\n"
+               "                            SIZE x SIZE sRGB PNG atlas (a power of two,\n"
+               "                            16..4096; a square tile per surface), textured\n"
+               "                            through TEXCOORD_0 instead of COLOR_0\n"
+               "  --save-solution F         write the solved fields to F\n"
+               "  --load-solution F         export F's fields instead of solving\n") +
+           solver_options_usage();
 }
 
 /// A solution: solved now (printing the summary unless quiet), or loaded.
@@ -559,6 +590,110 @@ int probe_command(Args& args) {
     return 0;
 }
 
+/// The format of `mbr export`, from the extension of its output, in any case.
+enum class ExportFormat { Glb, Ply };
+
+ExportFormat export_format(const std::string& path) {
+    const size_t dot = path.rfind('.');
+    const size_t slash = path.rfind('/');
+    std::string ext = dot == std::string::npos || (slash != std::string::npos && dot < slash)
+                          ? std::string()
+                          : path.substr(dot);
+    for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+    if (ext == ".glb") return ExportFormat::Glb;
+    if (ext == ".ply") return ExportFormat::Ply;
+    throw UsageError("-o " + path +
+                     ": the export format is chosen by the extension, .glb (glTF 2.0 binary) or "
+                     ".ply");
+}
+
+int export_command(Args& args) {
+    const std::string out = args.text("-o", "");
+    const double exposure = args.number("--exposure", 1);
+    const bool lightmaps = args.has("--lightmaps");
+    const int lightmap_size = args.integer("--lightmaps", 0, min_lightmap_size, max_lightmap_size);
+    const std::string save = args.text("--save-solution", "");
+    const std::string load = args.text("--load-solution", "");
+    if (out.empty()) throw UsageError("-o OUT.glb or -o OUT.ply is required");
+    const ExportFormat format = export_format(out);
+    if (lightmaps && !valid_lightmap_size(lightmap_size))
+        throw UsageError(
+            "--lightmaps must be a power of two in " + std::to_string(min_lightmap_size) + ".." +
+            std::to_string(max_lightmap_size) + " (got " + std::to_string(lightmap_size) + ")");
+    if (lightmaps && format != ExportFormat::Glb)
+        throw UsageError("--lightmaps needs a .glb output (a PLY file holds no textures)");
+    if (!save.empty() && !load.empty())
+        throw UsageError("--save-solution and --load-solution exclude each other");
+    if (!(exposure > 0)) throw UsageError("--exposure must be positive");
+    // As render does: outputs that cannot be written, or that clash, before any work.
+    const std::vector<std::string> outputs{out, save};
+    refuse_bad_outputs(outputs, {load});
+    SceneRun run = read_scene_run(args, "");
+    args.finish();
+    refuse_bad_outputs(outputs, run_inputs(run, load));
+    const int n_surfaces = int(run.scene.surfaces.size());
+    if (lightmaps && n_surfaces > 0 && smallest_lightmap_size(n_surfaces) > lightmap_size) {
+        const int least = smallest_lightmap_size(n_surfaces);
+        throw UsageError("--lightmaps " + std::to_string(lightmap_size) + " is too small for the " +
+                             std::to_string(n_surfaces) + " surfaces of " + run.path + ": " +
+                             (least ? "give at least " + std::to_string(least)
+                                    : std::string("even 4096 gives no 2 x 2 texels each")),
+                         false);
+    }
+
+    // The export's memory too, before the solve (as render's picture: check_render_cost).
+    CostEstimate cost = run.cost;
+    const double mesh_bytes = export_bytes(run.scene, lightmaps ? lightmap_size : 0);
+    cost.bytes += mesh_bytes;
+    cost.detail += ", export " + cell(mesh_bytes / (1 << 20), 1) + " MiB";
+    check_cost(cost, run.memory_budget, "exporting " + run.path, false,
+               "the depth" + std::string(lightmaps ? " or --lightmaps" : ""));
+
+    const bool report = !run.quiet && !is_standard_output(out) && !is_standard_output(save);
+    std::ostringstream summary;
+    const Solution solution = obtain_solution(run, load, report, summary);
+    std::vector<OutputFile> files;
+    if (!save.empty()) {
+        // Written with the export, all or none (radiosity/output/output_file.h).
+        std::ostringstream os;
+        save_solution(os, run.scene, solution);
+        MBR_CHECK_MSG(!os.fail(), "the solution of " << save << " could not be formatted");
+        files.push_back({save, os.str()});
+        if (report) summary << "wrote " << save << "\n";
+    }
+    const double start = now_seconds();
+    const RadiosityView view = radiosity_view(run.scene, solution);
+    const ExportMesh mesh = tessellate_for_export(run.scene, view);
+    std::string bytes;
+    if (format == ExportFormat::Glb) {
+        GlbOptions go;
+        go.exposure = exposure;
+        go.scene_name = run.path;
+        Lightmap lightmap;
+        if (lightmaps && n_surfaces > 0) {
+            lightmap = make_lightmap(view, lightmap_size, exposure);
+            go.lightmap = &lightmap;
+        }
+        bytes = encode_glb(mesh, go);
+    } else {
+        bytes = encode_ply(mesh, exposure);
+    }
+    const size_t n_bytes = bytes.size();
+    files.push_back({out, std::move(bytes)});
+    write_files(files);
+    if (report) {
+        summary << "exported " << mesh.surfaces.size() << " surfaces: " << mesh.vertex_count()
+                << " vertices, " << mesh.triangle_count() << " triangles"
+                << (lightmaps ? ", a " + std::to_string(lightmap_size) + " x " +
+                                    std::to_string(lightmap_size) + " lightmap"
+                              : std::string())
+                << ", " << n_bytes << " bytes, in " << cell(now_seconds() - start, 2) << " s\n"
+                << "wrote " << out << "\n";
+        std::cout << summary.str();
+    }
+    return 0;
+}
+
 int tables_command(Args& args) {
     std::cout << "== Table 1: parallel squares ==\n";
     int status = run_paper_table(args, paper_table1, 6, true);
@@ -616,6 +751,7 @@ int main(int argc, char** argv) {
     const Command commands[] = {
         {"render", render_usage(), render_command},
         {"probe", probe_usage(), probe_command},
+        {"export", export_usage(), export_command},
         {"reference", reference_usage, reference_command},
         {"tables",
          std::string("usage: mbr tables [--csv] [receiver options]\n"
@@ -635,7 +771,7 @@ int main(int argc, char** argv) {
             return run_main(static_cast<int>(sub.size()), sub.data(), c.usage, c.body);
         }
     if (first.empty()) {
-        std::cerr << "mbr: a command is required: render, probe, reference or tables "
+        std::cerr << "mbr: a command is required: render, probe, export, reference or tables "
                      "(mbr --help)\n";
         return 2;
     }
