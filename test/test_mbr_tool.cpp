@@ -33,6 +33,7 @@
 #include <vector>
 
 #include "math/vec3.h"
+#include "radiosity/output/render.h"
 #include "test/file_bytes.h"
 #include "test/report.h"
 #include "test/run_program.h"
@@ -170,6 +171,49 @@ TEST_CASE("mbr_tool: render writes a PNG of the camera's size and nothing else",
     stbi_image_free(pixels);
     CHECK(w == camera_width);
     CHECK(h == camera_height);
+}
+
+TEST_CASE("mbr_tool: --exposure auto shows the lit pixels' log-average at middle grey",
+          "[mbr_tool]") {
+    TempFolder dir;
+    write_text(dir / "lit floor.scene", lit_floor_scene);
+    const std::string scene = dir / "lit floor.scene";
+    const ToolRun run = run_mbr({"render", scene, "-o", dir / "auto.png", "--spp", "1", "--hdr",
+                                 dir / "auto.hdr", "--exposure", "auto"});
+    CAPTURE(run);
+    REQUIRE(run.status == 0);
+    // The exposure said is the one auto_exposure finds in the picture's radiance.
+    std::ifstream hdr_in(dir / "auto.hdr", std::ios::binary);
+    const mbr::Image radiance = mbr::read_hdr(hdr_in, "auto.hdr");
+    const double said = mbr::test::number_after(run.out, "exposure");
+    std::ostringstream exact;
+    exact.precision(17);
+    exact << mbr::auto_exposure(radiance);
+    CHECK(said == Approx(mbr::auto_exposure(radiance)).epsilon(1e-3));
+    // The same picture as that exposure given by hand (to the HDR file's 8-bit mantissas:
+    // within one level of 255).
+    const ToolRun by_hand = run_mbr({"render", scene, "-o", dir / "hand.png", "--spp", "1",
+                                     "--exposure", exact.str(), "--quiet"});
+    REQUIRE(by_hand.status == 0);
+    int w1 = 0, h1 = 0, n1 = 0, w2 = 0, h2 = 0, n2 = 0;
+    stbi_uc* a = stbi_load((dir / "auto.png").c_str(), &w1, &h1, &n1, 3);
+    stbi_uc* b = stbi_load((dir / "hand.png").c_str(), &w2, &h2, &n2, 3);
+    REQUIRE(a != nullptr);
+    REQUIRE(b != nullptr);
+    REQUIRE(w1 * h1 == w2 * h2);
+    int largest = 0, bright = 0;
+    for (int k = 0; k < 3 * w1 * h1; ++k) {
+        largest = std::max(largest, std::abs(int(a[k]) - int(b[k])));
+        bright = std::max(bright, int(a[k]));
+    }
+    stbi_image_free(a);
+    stbi_image_free(b);
+    CHECK(largest <= 1);
+    CHECK(bright > 64);  // and the picture is not black
+    // Anything else that is not a number is refused.
+    const ToolRun bad = run_mbr({"render", scene, "-o", dir / "x.png", "--exposure", "bright"});
+    CHECK(bad.status == 2);
+    CHECK_THAT(bad.err, Contains("--exposure expects a number"));
 }
 
 TEST_CASE("mbr_tool: a missing output folder is status 2, one line, and no file anywhere",

@@ -246,6 +246,21 @@ TEST_CASE("render: a surface's back is culled by default, black on request", "[r
     for (const Rgb& px : seen.pixels) CHECK(px.r == Approx(1 / Pi));
 }
 
+TEST_CASE("render: auto exposure shows the log-average luminance at 0.18", "[render]") {
+    Image half(4, 2);  // four pixels of luminance 0.1, four of 1.0
+    for (int x = 0; x < 4; ++x) {
+        half.at(x, 0) = {0.1, 0.1, 0.1};
+        half.at(x, 1) = {1, 1, 1};
+    }
+    CHECK(auto_exposure(half) == Approx(0.18 / std::sqrt(0.1)));
+    Image with_black = half;  // unlit pixels (the background) do not count
+    with_black.pixels.push_back({0, 0, 0});
+    with_black.width = 9;
+    with_black.height = 1;
+    CHECK(auto_exposure(with_black) == Approx(auto_exposure(half)));
+    CHECK(auto_exposure(Image(3, 3)) == 1);  // nothing lit: exposure 1
+}
+
 TEST_CASE("render: the framing camera stands up the way the lights hang", "[render]") {
     // The same open box turned so that z is up (the classic radiosity scenes' way): its light
     // on the ceiling faces down (-z), so the camera's up is +z and it looks horizontally.

@@ -38,6 +38,7 @@
 #include "radiosity/output/output_file.h"
 #include "radiosity/output/render.h"
 #include "radiosity/reference/probe.h"
+#include "radiosity/scene/line_reader.h"
 #include "radiosity/solver/superposition.h"
 
 #ifndef MBR_VERSION
@@ -100,7 +101,9 @@ std::string render_usage() {
                "  (docs/scene-format.md, \"camera\").\n"
                "  -o OUT.png                the image (required)\n"
                "  --spp n                   samples per pixel, 1..4096 (default 4)\n"
-               "  --exposure x              radiance multiplier before tone mapping (default 1)\n"
+               "  --exposure x|auto         radiance multiplier before tone mapping (default 1);\n"
+               "                            auto: the lit pixels' log-average luminance shows\n"
+               "                            at middle grey 0.18 (for lights in any unit)\n"
                "  --hdr OUT.hdr             also the linear radiance as Radiance HDR\n"
                "  --quadtree                draw each surface's final quadtree over the image\n"
                "  --save-solution F         write the solved fields to F\n"
@@ -451,7 +454,10 @@ Camera chosen_camera(const Scene& scene, const CameraArgs& c) {
 int render_command(Args& args) {
     const std::string out = args.text("-o", "");
     const int spp = args.integer("--spp", 4, 1, 4096);
-    const double exposure = args.number("--exposure", 1);
+    // --exposure x, or auto (auto_exposure, render.h): chosen from the picture once rendered.
+    const std::string exposure_text = args.text("--exposure", "1");
+    const bool auto_exposed = exposure_text == "auto";
+    const double exposure = auto_exposed ? 1 : parse_number(exposure_text, "--exposure");
     const std::string hdr = args.text("--hdr", "");
     const bool quadtree = args.flag("--quadtree");
     const std::string save = args.text("--save-solution", "");
@@ -516,7 +522,8 @@ int render_command(Args& args) {
     }
     const double start = now_seconds();
     const Image radiance = render_radiance(shown, *run.octree, radiosity_view(shown, solution), ro);
-    Image display = tone_map(radiance, exposure);
+    const double shown_exposure = auto_exposed ? auto_exposure(radiance) : exposure;
+    Image display = tone_map(radiance, shown_exposure);
     if (quadtree)
         draw_quadtree_overlay(display, shown, *run.octree, &solution.leaves, ro.overlay_colour,
                               nullptr, back_faces);
@@ -529,7 +536,10 @@ int render_command(Args& args) {
     write_files(files);
     if (report) {
         summary << "rendered " << radiance.width << " x " << radiance.height << ", " << spp
-                << " samples per pixel, in " << cell(now_seconds() - start, 2) << " s\n"
+                << " samples per pixel, in " << cell(now_seconds() - start, 2) << " s"
+                << (auto_exposed ? ", exposure " + detail::fmt_approx(shown_exposure) + " (auto)"
+                                 : "")
+                << "\n"
                 << "wrote " << out << (hdr.empty() ? "" : " and " + hdr) << "\n";
         std::cout << summary.str();
     }

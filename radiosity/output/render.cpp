@@ -460,6 +460,19 @@ Image tone_map(const Image& radiance, double exposure) {
     return display;
 }
 
+double auto_exposure(const Image& radiance) {
+    // Reinhard et al. (2002): the log-average luminance of the scene shown at the key 0.18.
+    double log_sum = 0;
+    long lit = 0;
+    for (const Rgb& p : radiance.pixels) {
+        const double y = 0.2126 * p.r + 0.7152 * p.g + 0.0722 * p.b;
+        if (!(std::isfinite(y) && y > 0)) continue;
+        log_sum += std::log(y);
+        ++lit;
+    }
+    return lit == 0 ? 1.0 : 0.18 / std::exp(log_sum / double(lit));
+}
+
 void draw_quadtree_overlay(Image& display, const Scene& scene, const Octree& octree,
                            const std::vector<std::vector<DyadicCell>>* leaves, Rgb colour,
                            RenderStats* stats, BackFaces back_faces) {

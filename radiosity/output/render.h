@@ -96,6 +96,14 @@ double linear_to_srgb(double linear);
 /// Display values for write_png: exposure x radiance, clipped to [0,1] (NaN to 0), sRGB-encoded.
 Image tone_map(const Image& radiance, double exposure);
 
+/// The exposure of `mbr render --exposure auto`: the log-average luminance (0.2126 R + 0.7152 G
+/// + 0.0722 B) of the pixels that see anything lit (luminance > 0) shown at 0.18, the middle grey
+/// of photography (Reinhard, Stark, Shirley and Ferwerda 2002's key value), so that a scene whose
+/// lights are given in any unit (MGF's lm/m^2, an OBJ's Ke) shows its walls in the middle of the
+/// range; 1 when no pixel is lit. The Cornell box gets about 3.2 (its exposure 1 is darker than
+/// a photograph's), the room 4.7, the classroom of the MGF scenes after one shot 46.
+double auto_exposure(const Image& radiance);
+
 /// Draws the boundaries of every surface's quadtree leaves, one pixel wide, in `colour` over a
 /// display image of scene.camera's size. A pixel is a line pixel when the (surface, leaf) seen
 /// through its centre differs from that of its right or lower neighbour. leaves[i] holds the
