@@ -75,3 +75,12 @@ TEST_CASE("progress: a run shorter than the interval, or turned off, says nothin
               sleep_for(0.3);
           }).empty());
 }
+
+TEST_CASE("progress: the time left in seconds, minutes or hours", "[progress]") {
+    CHECK(mbr::format_duration(0.4) == "0 s");
+    CHECK(mbr::format_duration(42) == "42 s");
+    CHECK(mbr::format_duration(99) == "99 s");
+    CHECK(mbr::format_duration(2322) == "39 min");
+    CHECK(mbr::format_duration(7199) == "120 min");
+    CHECK(mbr::format_duration(12600) == "3.5 h");
+}

@@ -72,6 +72,17 @@ void ProgressReporter::draw_now_locked() {
     show_locked(line_locked(now));
 }
 
+std::string format_duration(double seconds) {
+    char text[32];
+    if (seconds < 100)
+        std::snprintf(text, sizeof text, "%.0f s", seconds);
+    else if (seconds < 7200)
+        std::snprintf(text, sizeof text, "%.0f min", seconds / 60);
+    else
+        std::snprintf(text, sizeof text, "%.1f h", seconds / 3600);
+    return text;
+}
+
 std::string ProgressReporter::line_locked(double now) const {
     if (stage_.empty()) return "";
     std::string line;
@@ -85,8 +96,8 @@ std::string ProgressReporter::line_locked(double now) const {
     if (!detail_.empty()) line += ": " + detail_;
     char tail[96];
     if (seconds_left_ >= 0)
-        std::snprintf(tail, sizeof tail, ", %.1f s, about %.0f s left", now - stage_start_,
-                      seconds_left_);
+        std::snprintf(tail, sizeof tail, ", %.1f s, about %s left", now - stage_start_,
+                      format_duration(seconds_left_).c_str());
     else
         std::snprintf(tail, sizeof tail, ", %.1f s", now - stage_start_);
     return line + tail;

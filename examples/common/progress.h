@@ -13,6 +13,9 @@
 
 namespace mbr {
 
+/// A duration for a progress line: "42 s" below 100 s, "38 min" below two hours, else "3.5 h".
+std::string format_duration(double seconds);
+
 /// Reports the current stage of a run from a thread of its own, so that a stage with no
 /// intermediate events (building an octree, a long first shot) still shows it is alive. The
 /// run's thread sets what is being done (stage, update); every call is cheap and thread-safe.

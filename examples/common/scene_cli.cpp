@@ -28,7 +28,8 @@ std::string solver_options_usage() {
     return "  SCENE                     a scene file (docs/scene-format.md), a Wavefront OBJ file\n"
            "                            (.obj, with its MTL libraries) or an MGF file (.mgf)\n" +
            option_usage() +
-           "  --strict                  refuse every fault of an imported OBJ, MTL, MGF or texture\n"
+           "  --strict                  refuse every fault of an imported OBJ, MTL, MGF or "
+           "texture\n"
            "                            (default: repair it where the intent is clear, warn)\n"
            "  --light NAME[=E]          make material NAME, or the surfaces NAME and NAME.K,\n"
            "                            emit E (one number, or R,G,B; default: a mean radiosity\n"
@@ -323,21 +324,32 @@ namespace {
 /// under way when `done` and `total` are given.
 struct ShotProgress {
     int shot = 0, max_shots = 0;
-    double left = 1;     // unshot share after the last shot
-    double target = 0;   // the convergence threshold
-    double elapsed = 0;  // seconds of the shots so far
+    double left = 1;          // unshot share after the last shot
+    double target = 0;        // the convergence threshold
+    double elapsed = 0;       // seconds of the shots so far
+    double shot_start = 0;    // now_seconds() when the shot under way began
+    int done = 0, total = 0;  // its receivers done, of
     double fraction() const {
         return std::clamp(left > 0 && target > 0 ? std::log(left) / std::log(target) : 1.0, 0.0,
                           1.0);
     }
     /// Assumes the unshot power keeps falling geometrically to the target, and no more shots
-    /// than the limit at the mean time a shot has taken.
-    double seconds_left() const {
-        if (shot < 1) return -1;
-        double rest = (max_shots - shot) * elapsed / shot;
+    /// than the limit, at the mean time a shot has taken; the shot under way counts with the
+    /// time its receivers so far say it will take (one slow shot among fast ones, a wall
+    /// shooting at hundreds of boxes, is not "about 1 s left" while it runs).
+    double seconds_left(double now) const {
+        double current = 0, projected = 0;
+        if (done > 0 && total > 0) {
+            current = std::max(0.0, now - shot_start);
+            projected = current * total / done;
+        }
+        const int counted = shot + (projected > 0 ? 1 : 0);
+        if (counted < 1) return -1;
+        const double mean = (elapsed + projected) / counted;
+        double rest = (max_shots - counted) * mean;
         if (left > target && left < 1 && target > 0)
-            rest = std::min(rest, elapsed * std::log(left / target) / std::log(1 / left));
-        return rest;
+            rest = std::min(rest, mean * shot * std::log(left / target) / std::log(1 / left));
+        return std::max(0.0, rest) + (projected - current);
     }
 };
 
@@ -356,10 +368,12 @@ Solution solve_scene(SceneRun& run, bool progress) {
     if (reporter) reporter->stage("setting up the solver");
     const auto shot_stage = [&] {
         in_shot = true;
+        sp.shot_start = now_seconds();
+        sp.done = sp.total = 0;
         std::snprintf(text, sizeof text, "shot %d/%d, unshot %.3g%%", sp.shot + 1, sp.max_shots,
                       100 * sp.left);
         reporter->stage(text);
-        reporter->update("", sp.fraction(), sp.seconds_left());
+        reporter->update("", sp.fraction(), sp.seconds_left(sp.shot_start));
     };
     Solution solution = solve(
         run.scene, *run.octree, run.options,
@@ -382,8 +396,10 @@ Solution solve_scene(SceneRun& run, bool progress) {
         [&](int done, int total) {
             if (!reporter) return;
             if (!in_shot) shot_stage();
+            sp.done = done;
+            sp.total = total;
             std::snprintf(text, sizeof text, "%d/%d receivers", done, total);
-            reporter->update(text, sp.fraction(), sp.seconds_left());
+            reporter->update(text, sp.fraction(), sp.seconds_left(now_seconds()));
         });
     if (reporter) reporter->stage("");
     return solution;
