@@ -134,9 +134,9 @@ TEST_CASE("options: a bad value names the option and its range, in a scene and o
     CHECK(flag_error(scene, {"--order", "9"}) == "--order '9' is outside [2, 8]");
     CHECK(set_error("set tolerance 1") == "tolerance 1 is outside (0, 1)");
     CHECK(flag_error(scene, {"--tolerance", "1"}) == "--tolerance 1 is outside (0, 1)");
-    CHECK(set_error("set shadows soft") == "shadows 'soft' is not 'exact', 'paper' or 'none'");
+    CHECK(set_error("set shadows soft") == "shadows 'soft' is not 'exact', 'paper', 'none' or 'auto'");
     CHECK(flag_error(scene, {"--shadows", "soft"}) ==
-          "--shadows 'soft' is not 'exact', 'paper' or 'none'");
+          "--shadows 'soft' is not 'exact', 'paper', 'none' or 'auto'");
     CHECK(flag_error(scene, {"--shots", "x"}) == "expected an integer for --shots, found 'x'");
     CHECK_THAT(flag_error(scene, {"--ambient", "maybe"}),
                Catch::Contains("--ambient 'maybe' is neither 'true' nor 'false'"));

@@ -627,3 +627,49 @@ TEST_CASE("hidden regions: texels no smaller than 1/2048 of the scene, 4 to 64 a
         CHECK(face.resolution() >= 4);
     }
 }
+
+TEST_CASE("shadows auto: exact between few occluding surfaces, the paper's between many",
+          "[solver][shadows]") {
+    // A lamp above a floor with n small boxes between them (six surfaces each): the lamp-to-
+    // floor pair has 6 n occluding surfaces, 6 for one box, 24 for four.
+    auto scene_with = [](int boxes) {
+        std::ostringstream text;
+        text << "material white reflectance 0.5 0.5 0.5\n"
+                "material lamp reflectance 0 0 0 emission 10 10 10\n"
+                "rectangle floor white -2 0 -2  0 0 4  4 0 0\n"
+                "rectangle lamp lamp -0.5 2 -0.5  1 0 0  0 0 1\n";
+        for (int b = 0; b < boxes; ++b) {
+            const double x = -1.2 + 0.8 * b;
+            text << "box block" << b << " white " << x << " 0.8 -0.2 " << x + 0.3 << " 1.1 0.1\n";
+        }
+        std::istringstream in(text.str());
+        return parse_scene(in, "boxes.scene");
+    };
+    for (const int boxes : {1, 4}) {
+        CAPTURE(boxes);
+        const Scene scene = scene_with(boxes);
+        REQUIRE(scene.settings.shadows == ShadowSetting::Auto);  // the default
+        const Octree octree = build_octree(scene);
+        SolverOptions o = quick_options(scene, 1);
+        REQUIRE(o.exact_shadow_surfaces == 16);
+        REQUIRE(o.receiver.shadows.method == ShadowMethod::Exact);
+        const Solution automatic = solve(scene, octree, o);
+        const int floor = scene.find_surface("floor");
+        if (boxes == 1) {
+            CHECK(automatic.stats.paper_transfers == 0);  // 6 surfaces between: exact
+        } else {
+            CHECK(automatic.stats.paper_transfers >= 1);  // 24: the floor takes the fractions
+            CHECK(automatic.stats.paper_transfers < automatic.stats.transfers);
+        }
+        CHECK(automatic.stats.transfers == automatic.stats.per_shot[0].receivers);
+        // The floor's power under auto against exact visibility everywhere: within 2 %.
+        o.exact_shadow_surfaces = 0;
+        const Solution exact = solve(scene, octree, o);
+        CHECK(exact.stats.paper_transfers == 0);
+        // (The floor's area factor is constant: its mean B stands for its power.)
+        const Rgb a_rgb = automatic.radiosity[size_t(floor)].integrate();
+        const Rgb e_rgb = exact.radiosity[size_t(floor)].integrate();
+        const double a = a_rgb.r + a_rgb.g + a_rgb.b, e = e_rgb.r + e_rgb.g + e_rgb.b;
+        CHECK(a == Approx(e).epsilon(0.02));
+    }
+}

@@ -453,6 +453,10 @@ void print_summary(std::ostream& os, const SceneRun& run, const SolveStats& st) 
        << st.coefficients << " per channel\n"
        << "kernel evaluations " << st.kernel_evals << ", analytic form factors "
        << st.analytic_evals << ", shadow rays " << st.rays << "\n";
+    if (st.paper_transfers > 0)
+        os << "shadows auto: the paper's fractions for " << st.paper_transfers << " of "
+           << st.transfers << " transfers (more than " << run.options.exact_shadow_surfaces
+           << " occluding surfaces between the pair), exact visibility for the rest\n";
 }
 
 double write_render(const SceneRun& run, const Solution& solution, const std::string& path,

@@ -114,9 +114,10 @@ std::vector<OptionSpec> make_option_table() {
                        "facets per curved parameter direction when rays are cast at curved "
                        "surfaces (at least 3 along an angle; one along a cylinder's height or a "
                        "disk's radius, which are straight)"),
-        choice_option("shadows", &S::shadows, {"exact", "paper", "none"},
+        choice_option("shadows", &S::shadows, {"exact", "paper", "none", "auto"},
                       "visibility inside (21) (beyond the paper), the paper's fractions (28) "
-                      "with masking, or no shadows"),
+                      "with masking, no shadows, or auto: exact, but the paper's for a pair "
+                      "with more than 16 occluding surfaces between its two"),
         real_option("tolerance", &S::tolerance, 0, 1, true, true, "x",
                     "accuracy relative to the scene's radiosity scale (emitted power / total "
                     "area): every transfer's absolute tolerance"),

@@ -18,7 +18,9 @@ namespace mbr {
 enum class ShadowSetting {
     Exact,  // "exact": visibility inside (21), the visible part of the shooter (beyond the paper)
     Paper,  // "paper": fractions (28) at the fulcrums, shadow subdivision and masking
-    None    // "none": no shadows
+    None,   // "none": no shadows
+    Auto    // "auto": exact, except for a pair with many occluding surfaces between it, which
+            //   takes the paper's (SolverOptions::exact_shadow_surfaces)
 };
 /// How the increment is continued outside [0,1]^2 (section 6, "Extrapolation").
 enum class ExtrapolationSetting {
@@ -63,7 +65,7 @@ struct SolverSettings {
     double convergence = 1e-3;  // stop when the largest unshot power < this x emitted
     bool self_transfer = true;  // a surface that can see itself (concave curved) lights itself
     int tessellation = 16;      // facets per parameter direction for ray casting
-    ShadowSetting shadows = ShadowSetting::Exact;
+    ShadowSetting shadows = ShadowSetting::Auto;
     double tolerance = 2e-3;  // accuracy relative to the scene's radiosity scale
     UnifySetting unify = UnifySetting::Projection;
     bool ambient = true;    // ambient correction of the unshot power at the end

@@ -160,9 +160,15 @@ SolverOptions solver_options(const SolverSettings& s) {
     // DESIGN: kernel-weighted fractions by default (docs/method.md): the Cornell box with paper
     // shadows 1.26 / 5.60 % with the paper's area shares, 0.62 / 3.20 % with them.
     o.receiver.shadows.kernel_weighted = s.fraction_rays == FractionRaysSetting::Kernel;
-    o.receiver.shadows.method = s.shadows == ShadowSetting::Exact   ? ShadowMethod::Exact
-                                : s.shadows == ShadowSetting::Paper ? ShadowMethod::Fractions
-                                                                    : ShadowMethod::None;
+    o.receiver.shadows.method =
+        s.shadows == ShadowSetting::Exact || s.shadows == ShadowSetting::Auto ? ShadowMethod::Exact
+        : s.shadows == ShadowSetting::Paper ? ShadowMethod::Fractions
+                                            : ShadowMethod::None;
+    // DESIGN: auto, the default: exact visibility costs per sample with the occluders that cut
+    // the shooter's image, the paper's fractions (28) per fulcrum with a bounded count of rays;
+    // the Cornell box's pairs have at most 10 occluding surfaces between them and keep exact
+    // visibility, a floor under 500 boxes takes the fractions (docs/method.md, "Shadows auto").
+    if (s.shadows == ShadowSetting::Auto) o.exact_shadow_surfaces = 16;
     o.max_shots = s.max_shots;
     o.convergence = s.convergence;
     o.self_transfer = s.self_transfer;
@@ -521,6 +527,11 @@ std::vector<ProgressiveSolver::Received> ProgressiveSolver::transfer_to(
                              [&rho](double s, double t) { return rho.value(s, t); }),
             hidden_[i].any() ? &hidden_[i] : nullptr};
         const OcclusionContext& occlusion = contexts[size_t(k)];
+        if (options_.exact_shadow_surfaces > 0 && options.shadows.method == ShadowMethod::Exact &&
+            int(occlusion.surface_boxes.size()) > options_.exact_shadow_surfaces) {
+            options.shadows.method = ShadowMethod::Fractions;
+            results[k].paper = true;
+        }
         ReceiverState state;
         results[k].field = transfer(shooter, receiver, options, &results[k].stats, &state,
                                     &occlusion, duals_[size_t(options.m)].get());
@@ -605,6 +616,7 @@ void ProgressiveSolver::superpose(const std::vector<int>& receivers, std::vector
         shot.kernel_evals += r.stats.n_kernel_evals;
         shot.analytic_evals += r.stats.n_analytic_evals;
         shot.rays += r.stats.n_rays;
+        shot.paper_transfers += r.paper ? 1 : 0;
         shot.finest_level = std::max(shot.finest_level, r.field.level());
         std::vector<std::uint64_t>& cells = split_cells_[i];
         cells.insert(cells.end(), r.splits.begin(), r.splits.end());
@@ -667,6 +679,8 @@ ShotStats ProgressiveSolver::shoot() {
     st.kernel_evals += shot.kernel_evals;
     st.analytic_evals += shot.analytic_evals;
     st.rays += shot.rays;
+    st.transfers += shot.receivers;
+    st.paper_transfers += shot.paper_transfers;
     st.limited_power += shot.limited;
     st.per_shot.push_back(shot);
     return shot;

@@ -60,6 +60,9 @@ struct SolverOptions {
                                     //   is viewed non-negative by the scene's setting)
     bool irradiance_fields = true;  // beyond the paper: a surface with a textured reflectance
                                     //   stores H (B = E + rho H, radiosity_view.h)
+    int exact_shadow_surfaces = 0;  // > 0 with exact shadows (`set shadows auto`): a pair whose
+                                    //   occluder candidates belong to more surfaces than this
+                                    //   takes the paper's fractions instead
     bool ambient = true;            // beyond the paper: at the end, the power still unshot is
                                     //   sent on through the measured coupling of the surfaces
                                     //   (the fraction of each shooter's power each receiver got,
@@ -97,6 +100,7 @@ struct ShotStats {
     double limited = 0;        // power the limiter changed (clipping overshoots down: <= 0),
                                //   sum of channels
     long rays = 0;             // shadow rays
+    int paper_transfers = 0;   // transfers that took the paper's fractions under shadows auto
     int finest_level = 0;      // finest level of its results
     double seconds = 0;
 };
@@ -112,6 +116,8 @@ struct SolveStats {
     long coefficients = 0;       // coefficients of the solved fields (all surfaces, per channel)
     long kernel_evals = 0, rays = 0;
     long analytic_evals = 0;   // closed-form form factors (ShotStats::analytic_evals)
+    long transfers = 0;        // of all shots (ShotStats::receivers)
+    long paper_transfers = 0;  //   of which with the paper's fractions under shadows auto
     double ambient_power = 0;  // power the ambient correction added (sum of channels)
     double limited_power = 0;  // the limiter's change of the reflected power, all shots (<= 0)
     std::vector<ShotStats> per_shot;
@@ -214,6 +220,7 @@ private:
         SplineField field;  // dB_i, or dH_i for an irradiance receiver
         TransferStats stats;
         std::vector<std::uint64_t> splits;
+        bool paper = false;  // shadows auto gave it the paper's fractions
     };
     /// The surfaces that receive from shooter h: every other surface that reflects and faces h
     /// (front to front), and h itself when it is concave and self_transfer is on.
