@@ -163,6 +163,17 @@ std::string export_usage() {
            solver_options_usage();
 }
 
+/// The solution as the file `path` to write (save_solution's format), with "wrote PATH" in the
+/// summary when reporting.
+OutputFile solution_file(const std::string& path, const Scene& scene, const Solution& solution,
+                         bool report, std::ostream& summary) {
+    std::ostringstream os;
+    save_solution(os, scene, solution);
+    MBR_CHECK_MSG(!os.fail(), "the solution of " << path << " could not be formatted");
+    if (report) summary << "wrote " << path << "\n";
+    return {path, os.str()};
+}
+
 /// A solution: solved now (printing the summary unless quiet), or loaded.
 Solution obtain_solution(SceneRun& run, const std::string& load, bool report,
                          std::ostream& summary) {
@@ -512,14 +523,8 @@ int render_command(Args& args) {
     const Scene lit =
         group_args.on() ? weighted_scene(run.scene, plan.groups, plan.weights) : Scene{};
     const Scene& shown = group_args.on() ? lit : run.scene;
-    if (!save.empty()) {
-        // Written with the images, all or none (radiosity/output/output_file.h).
-        std::ostringstream os;
-        save_solution(os, run.scene, solution);
-        MBR_CHECK_MSG(!os.fail(), "the solution of " << save << " could not be formatted");
-        files.push_back({save, os.str()});
-        if (report) summary << "wrote " << save << "\n";
-    }
+    // Written with the images, all or none (radiosity/output/output_file.h).
+    if (!save.empty()) files.push_back(solution_file(save, run.scene, solution, report, summary));
     const double start = now_seconds();
     const Image radiance = render_radiance(shown, *run.octree, radiosity_view(shown, solution), ro);
     const double shown_exposure = auto_exposed ? auto_exposure(radiance) : exposure;
@@ -577,13 +582,8 @@ int probe_command(Args& args) {
     std::vector<OutputFile> none;  // probe saves no group solutions
     const Solution solution = group_args.on() ? relight(run, plan, report, summary, none)
                                               : obtain_solution(run, load, report, summary);
-    if (!save.empty()) {
-        std::ostringstream os;
-        save_solution(os, run.scene, solution);
-        MBR_CHECK_MSG(!os.fail(), "the solution of " << save << " could not be formatted");
-        write_files({{save, os.str()}});  // a temporary name, then renamed
-        if (report) summary << "wrote " << save << "\n";
-    }
+    if (!save.empty())  // a temporary name, then renamed
+        write_files({solution_file(save, run.scene, solution, report, summary)});
     std::cerr << summary.str();
     // Relit: B is formed with the groups' emissions times their weights (see render_command).
     const Scene lit =
@@ -663,14 +663,8 @@ int export_command(Args& args) {
     std::ostringstream summary;
     const Solution solution = obtain_solution(run, load, report, summary);
     std::vector<OutputFile> files;
-    if (!save.empty()) {
-        // Written with the export, all or none (radiosity/output/output_file.h).
-        std::ostringstream os;
-        save_solution(os, run.scene, solution);
-        MBR_CHECK_MSG(!os.fail(), "the solution of " << save << " could not be formatted");
-        files.push_back({save, os.str()});
-        if (report) summary << "wrote " << save << "\n";
-    }
+    // Written with the export, all or none (radiosity/output/output_file.h).
+    if (!save.empty()) files.push_back(solution_file(save, run.scene, solution, report, summary));
     const double start = now_seconds();
     const RadiosityView view = radiosity_view(run.scene, solution);
     const ExportMesh mesh = tessellate_for_export(run.scene, view);

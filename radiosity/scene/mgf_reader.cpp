@@ -149,21 +149,17 @@ public:
 private:
     bool strict() const { return state_.options().strict; }
 
+    /// A repaired fault's warning (warn_import, obj_reader.h).
     void warn(const std::string& kind, const std::string& file, int line,
               const std::string& message) {
-        SceneWarning w;
-        w.kind = kind;
-        w.file = file;
-        w.line = line;
-        w.message = message;
-        scene_.warn(w);
+        warn_import(scene_, kind, file, line, message);
     }
 
-    /// A fault at `line`: refused when strict, else a warning of `kind` with what is done.
+    /// A fault at `line`: refused when strict, else a warning of `kind` with what is done
+    /// (import_fault, obj_reader.h).
     void fault(const Line& line, const std::string& kind, const std::string& message,
                const std::string& then) {
-        if (strict()) line.fail(message);
-        warn(kind, line.file, line.number, message + "; " + then);
+        import_fault(scene_, strict(), line, kind, message, then);
     }
 
     /// The file's entities, continued lines (a trailing backslash) joined, then executed.

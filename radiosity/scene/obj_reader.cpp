@@ -169,24 +169,16 @@ public:
 private:
     bool strict() const { return state_.options().strict; }
 
-    /// A forgiving import's record of a repaired fault: one warning of `kind` (Scene::warn
-    /// keeps the first instance and counts the rest).
+    /// A repaired fault's warning (warn_import).
     void warn(const std::string& kind, const std::string& file, int line,
               const std::string& message) {
-        SceneWarning w;
-        w.kind = kind;
-        w.file = file;
-        w.line = line;
-        w.message = message;
-        scene_.warn(w);
+        warn_import(scene_, kind, file, line, message);
     }
 
-    /// A fault met at `line`: refused when the import is strict, else a warning of `kind`
-    /// saying `message` and what the import does instead (`then`).
+    /// A fault met at `line` (import_fault).
     void fault(const Line& line, const std::string& kind, const std::string& message,
                const std::string& then) {
-        if (strict()) line.fail(message);
-        warn(kind, line.file, line.number, message + "; " + then);
+        import_fault(scene_, strict(), line, kind, message, then);
     }
 
     /// One OBJ statement. A forgiving import repairs what its statement could not do: an
@@ -624,6 +616,22 @@ void LoadState::charge(const Line& line) {
     if (++n_files_ > max_files_read)
         line.fail("more than " + std::to_string(max_files_read) +
                   " files are read by this scene (includes, OBJ, MTL, textures)");
+}
+
+void warn_import(Scene& scene, const std::string& kind, const std::string& file, int line,
+                 const std::string& message) {
+    SceneWarning w;
+    w.kind = kind;
+    w.file = file;
+    w.line = line;
+    w.message = message;
+    scene.warn(w);
+}
+
+void import_fault(Scene& scene, bool strict, const Line& line, const std::string& kind,
+                  const std::string& message, const std::string& then) {
+    if (strict) line.fail(message);
+    warn_import(scene, kind, line.file, line.number, message + "; " + then);
 }
 
 void number_surface_names(Scene& scene) {
