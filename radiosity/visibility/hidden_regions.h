@@ -60,10 +60,10 @@ int hidden_texels(double size, double scene_size);
 
 /// The mask of `surface` (its index in the octree's polygons' surface ids is `surface_id`):
 /// hidden_texels x hidden_texels texels; from each texel centre, rays over the hemisphere in
-/// front; a ray that meets a polygon's
-/// back before anything else counts as hidden, one that meets a front face or leaves the scene
-/// as visible. A texel is tested with 4 rays first and the rest only when all 4 were hidden.
-/// Rays are seeded from the surface and the texel (reproducible, thread-count independent).
+/// front; a ray that meets a polygon's back before anything else counts as hidden, one that
+/// meets a front face or leaves the scene as visible. A texel is tested with 4 rays first and the
+/// rest only when all 4 were hidden. Rays are seeded from the surface and the texel (reproducible,
+/// thread-count independent).
 HiddenMask find_hidden(const Surface& surface, int surface_id, const Octree& octree);
 
 }  // namespace mbr
