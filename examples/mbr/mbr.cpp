@@ -604,12 +604,7 @@ int probe_command(Args& args) {
 enum class ExportFormat { Glb, Ply };
 
 ExportFormat export_format(const std::string& path) {
-    const size_t dot = path.rfind('.');
-    const size_t slash = path.rfind('/');
-    std::string ext = dot == std::string::npos || (slash != std::string::npos && dot < slash)
-                          ? std::string()
-                          : path.substr(dot);
-    for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+    const std::string ext = detail::lowercase_extension(path);
     if (ext == ".glb") return ExportFormat::Glb;
     if (ext == ".ply") return ExportFormat::Ply;
     throw UsageError("-o " + path +

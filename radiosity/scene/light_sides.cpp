@@ -6,6 +6,7 @@
 #include <cmath>
 #include <unordered_set>
 
+#include "radiosity/scene/duplicate_faces.h"
 #include "radiosity/scene/line_reader.h"
 #include "radiosity/scene/mgf_reader.h"
 #include "radiosity/scene/scene_octree.h"
@@ -131,6 +132,12 @@ void face_lights_to_the_open_side(Scene& scene, const ImportOptions& options) {
         w.count = long(lights.size());
     }
     scene.warn(w);
+}
+
+void repair_loaded_scene(Scene& scene, const ImportOptions& options) {
+    drop_duplicate_surfaces(scene, options);
+    face_lights_to_the_open_side(scene, options);
+    add_back_sides(scene, two_sided_materials(scene));
 }
 
 }  // namespace mbr

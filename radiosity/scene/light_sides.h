@@ -42,4 +42,10 @@ std::vector<BackFacingLight> find_back_facing_lights(const Scene& scene,
 /// and the warning says so ("light faces away").
 void face_lights_to_the_open_side(Scene& scene, const ImportOptions& options);
 
+/// What every load does once all its surfaces are in (a scene with its includes and imports, or
+/// an OBJ or MGF file on its own): repeated faces dropped (drop_duplicate_surfaces,
+/// duplicate_faces.h), imported lights that face away turned round
+/// (face_lights_to_the_open_side), and two-sided materials given their backs (add_back_sides).
+void repair_loaded_scene(Scene& scene, const ImportOptions& options);
+
 }  // namespace mbr

@@ -95,6 +95,10 @@ std::string fmt(double x);
 /// did not write and which need no more than six significant digits.
 std::string fmt_approx(double x);
 
+/// The extension of the file named by `path` in lower case, with its dot (".obj" for
+/// "ROOM.OBJ"; "" without one), by which programs tell file formats apart.
+std::string lowercase_extension(const std::string& path);
+
 /// "1 word", "3 words": a count with its noun in the right number.
 std::string counted(long n, const std::string& singular, const std::string& plural);
 

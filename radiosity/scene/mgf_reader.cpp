@@ -14,7 +14,6 @@
 #include <vector>
 
 #include "math/check.h"
-#include "radiosity/scene/duplicate_faces.h"
 #include "radiosity/scene/faces_to_quads.h"
 #include "radiosity/scene/light_sides.h"
 #include "radiosity/scene/line_reader.h"
@@ -133,35 +132,18 @@ struct Transform {
     std::vector<Affine> after;                    // the map after each array (its -i parts)
 };
 
-class MgfReader {
+class MgfReader : ImportReader {
 public:
-    explicit MgfReader(LoadState& state) : state_(state) {}
+    explicit MgfReader(LoadState& state) : ImportReader(state) {}
 
     Scene read(std::istream& in, const std::string& name) {
         top_ = name;
         read_file(in, name, 0);
         if (scene_.surfaces.empty()) throw InputError(name, 0, "the MGF file has no surfaces");
-        number_surface_names(scene_);
-        scene_.input_files = state_.files();
-        return std::move(scene_);
+        return finish();
     }
 
 private:
-    bool strict() const { return state_.options().strict; }
-
-    /// A repaired fault's warning (warn_import, obj_reader.h).
-    void warn(const std::string& kind, const std::string& file, int line,
-              const std::string& message) {
-        warn_import(scene_, kind, file, line, message);
-    }
-
-    /// A fault at `line`: refused when strict, else a warning of `kind` with what is done
-    /// (import_fault, obj_reader.h).
-    void fault(const Line& line, const std::string& kind, const std::string& message,
-               const std::string& then) {
-        import_fault(scene_, strict(), line, kind, message, then);
-    }
-
     /// The file's entities, continued lines (a trailing backslash) joined, then executed.
     void read_file(std::istream& in, const std::string& name, int depth) {
         source_ = source_index(name);
@@ -850,8 +832,6 @@ private:
         xf_.resize(depth_xf - 1);
     }
 
-    LoadState& state_;
-    Scene scene_;
     std::string top_;
     int source_ = 0;  // the file being executed (Scene::sources)
     int line_ = 0;    // the line of the entity being added (for material warnings)
@@ -919,17 +899,13 @@ bool is_import_path(const std::string& path) {
 }
 
 bool is_mgf_path(const std::string& path) {
-    std::string ext = fs::path(path).extension().string();
-    for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
-    return ext == ".mgf";
+    return lowercase_extension(path) == ".mgf";
 }
 
 Scene parse_mgf(std::istream& in, const std::string& name, const ImportOptions& options) {
     LoadState state(options);
     Scene scene = read_mgf(in, name, state);
-    drop_duplicate_surfaces(scene, options);
-    face_lights_to_the_open_side(scene, options);
-    add_back_sides(scene, two_sided_materials(scene));
+    repair_loaded_scene(scene, options);
     return scene;
 }
 
@@ -939,9 +915,7 @@ Scene load_mgf(const std::string& path, const ImportOptions& options) {
     LoadState state(options);
     state.record(path);
     Scene scene = read_mgf(in, path, state);
-    drop_duplicate_surfaces(scene, options);
-    face_lights_to_the_open_side(scene, options);
-    add_back_sides(scene, two_sided_materials(scene));
+    repair_loaded_scene(scene, options);
     return scene;
 }
 

@@ -13,7 +13,6 @@
 #include <unordered_set>
 
 #include "math/check.h"
-#include "radiosity/scene/duplicate_faces.h"
 #include "radiosity/scene/faces_to_quads.h"
 #include "radiosity/scene/light_sides.h"
 
@@ -140,9 +139,9 @@ std::string locate(const std::string& from, const std::string& file) {
     return "";
 }
 
-class ObjReader {
+class ObjReader : ImportReader {
 public:
-    ObjReader(std::string name, LoadState& state) : name_(std::move(name)), state_(state) {
+    ObjReader(std::string name, LoadState& state) : ImportReader(state), name_(std::move(name)) {
         group_ = fs::path(name_).stem().string();
         if (group_.empty()) group_ = "obj";
         scene_.sources = {name_};  // every surface's statement is in this file
@@ -161,26 +160,10 @@ public:
                            w.message + ")";
             throw InputError(name_, 0, why);
         }
-        number_surface_names(scene_);
-        scene_.input_files = state_.files();
-        return std::move(scene_);
+        return finish();
     }
 
 private:
-    bool strict() const { return state_.options().strict; }
-
-    /// A repaired fault's warning (warn_import).
-    void warn(const std::string& kind, const std::string& file, int line,
-              const std::string& message) {
-        warn_import(scene_, kind, file, line, message);
-    }
-
-    /// A fault met at `line` (import_fault).
-    void fault(const Line& line, const std::string& kind, const std::string& message,
-               const std::string& then) {
-        import_fault(scene_, strict(), line, kind, message, then);
-    }
-
     /// One OBJ statement. A forgiving import repairs what its statement could not do: an
     /// unusable vertex keeps its place in the numbering (faces that use it are dropped), a face
     /// that cannot be made is dropped, an unknown material gives the default one, and any other
@@ -595,8 +578,6 @@ private:
     }
 
     std::string name_;
-    LoadState& state_;
-    Scene scene_;
     std::vector<Vec3> v_;                    // x is NaN for an unusable vertex
     std::vector<std::array<double, 2>> vt_;  // u is NaN for an unusable one
     long long n_vn_ = 0;
@@ -618,20 +599,26 @@ void LoadState::charge(const Line& line) {
                   " files are read by this scene (includes, OBJ, MTL, textures)");
 }
 
-void warn_import(Scene& scene, const std::string& kind, const std::string& file, int line,
-                 const std::string& message) {
+void ImportReader::warn(const std::string& kind, const std::string& file, int line,
+                        const std::string& message) {
     SceneWarning w;
     w.kind = kind;
     w.file = file;
     w.line = line;
     w.message = message;
-    scene.warn(w);
+    scene_.warn(w);
 }
 
-void import_fault(Scene& scene, bool strict, const Line& line, const std::string& kind,
-                  const std::string& message, const std::string& then) {
-    if (strict) line.fail(message);
-    warn_import(scene, kind, line.file, line.number, message + "; " + then);
+void ImportReader::fault(const Line& line, const std::string& kind, const std::string& message,
+                         const std::string& then) {
+    if (strict()) line.fail(message);
+    warn(kind, line.file, line.number, message + "; " + then);
+}
+
+Scene ImportReader::finish() {
+    number_surface_names(scene_);
+    scene_.input_files = state_.files();
+    return std::move(scene_);
 }
 
 void number_surface_names(Scene& scene) {
@@ -679,8 +666,7 @@ Scene read_obj(std::istream& in, const std::string& name, LoadState& state) {
 Scene parse_obj(std::istream& in, const std::string& name, const ImportOptions& options) {
     LoadState state(options);
     Scene scene = read_obj(in, name, state);
-    drop_duplicate_surfaces(scene, options);
-    face_lights_to_the_open_side(scene, options);
+    repair_loaded_scene(scene, options);
     return scene;
 }
 
@@ -690,17 +676,12 @@ Scene load_obj(const std::string& path, const ImportOptions& options) {
     LoadState state(options);
     state.record(path);
     Scene scene = read_obj(in, path, state);
-    drop_duplicate_surfaces(scene, options);
-    face_lights_to_the_open_side(scene, options);
+    repair_loaded_scene(scene, options);
     return scene;
 }
 
 bool is_obj_path(const std::string& path) {
-    const std::string ext = fs::path(path).extension().string();
-    return ext.size() == 4 && ext[0] == '.' &&
-           std::tolower(static_cast<unsigned char>(ext[1])) == 'o' &&
-           std::tolower(static_cast<unsigned char>(ext[2])) == 'b' &&
-           std::tolower(static_cast<unsigned char>(ext[3])) == 'j';
+    return lowercase_extension(path) == ".obj";
 }
 
 }  // namespace mbr

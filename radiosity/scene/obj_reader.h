@@ -72,15 +72,28 @@ private:
 /// that name, say `a.0` next to a group `a` of two faces).
 void number_surface_names(Scene& scene);
 
-/// A forgiving import's record of a repaired fault in `scene`: one warning of `kind`
-/// (Scene::warn keeps the first instance and counts the rest).
-void warn_import(Scene& scene, const std::string& kind, const std::string& file, int line,
-                 const std::string& message);
+/// What the OBJ and MGF readers share: the load's state, the scene being read, and the
+/// forgiving import's warnings and faults (ImportOptions).
+class ImportReader {
+protected:
+    explicit ImportReader(LoadState& state) : state_(state) {}
 
-/// A fault met at `line`: refused (InputError) when `strict`, else a warning of `kind` saying
-/// `message` and what the import does instead (`then`).
-void import_fault(Scene& scene, bool strict, const Line& line, const std::string& kind,
-                  const std::string& message, const std::string& then);
+    bool strict() const { return state_.options().strict; }
+    /// A repaired fault's record: one warning of `kind` (Scene::warn keeps the first instance
+    /// and counts the rest).
+    void warn(const std::string& kind, const std::string& file, int line,
+              const std::string& message);
+    /// A fault met at `line`: refused (InputError) when the import is strict, else a warning of
+    /// `kind` saying `message` and what the import does instead (`then`).
+    void fault(const Line& line, const std::string& kind, const std::string& message,
+               const std::string& then);
+    /// The scene read, its surfaces named uniquely (number_surface_names) and the files opened
+    /// recorded (Scene::input_files).
+    Scene finish();
+
+    LoadState& state_;
+    Scene scene_;
+};
 
 /// Reads OBJ text named `name` as part of the load `state` (parse_obj with a shared state),
 /// without the check for repeated faces, which the caller runs once on the whole scene.

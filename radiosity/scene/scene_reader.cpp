@@ -12,7 +12,6 @@
 #include <unordered_map>
 
 #include "math/check.h"
-#include "radiosity/scene/duplicate_faces.h"
 #include "radiosity/scene/faces_to_quads.h"
 #include "radiosity/scene/light_sides.h"
 #include "radiosity/scene/line_reader.h"
@@ -188,11 +187,9 @@ public:
             at.fail("min_depth " + std::to_string(s.min_depth) + " exceeds max_depth " +
                     std::to_string(s.max_depth));
         }
-        // Every surface is in now, from this file, its includes and its OBJ imports: repeats are
-        // found across all of them (duplicate_faces.h).
-        drop_duplicate_surfaces(scene_, state_.options());
-        face_lights_to_the_open_side(scene_, state_.options());
-        add_back_sides(scene_, two_sided_materials(scene_));
+        // Every surface is in now, from this file, its includes and its OBJ and MGF imports:
+        // repeats are found across all of them (repair_loaded_scene, light_sides.h).
+        repair_loaded_scene(scene_, state_.options());
         scene_.input_files = state_.files();
         return std::move(scene_);
     }
