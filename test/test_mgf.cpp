@@ -364,6 +364,12 @@ TEST_CASE("mgf: the forgiving import warns once per kind; strict refuses at the 
     CHECK(s.material_of(1).reflectance.maximum().b < 1);
     REQUIRE_THROWS_WITH(mgf(text, true), Contains("t.mgf:16") && Contains("frobnicate"));
     REQUIRE_THROWS_WITH(mgf("ies lamp.ies\n", true), Contains("not supported"));
+    // Names of the contexts that were never defined.
+    REQUIRE_THROWS_WITH(mgf("m a =\n c nope\n", true),
+                        Contains("t.mgf:2: undefined colour 'nope'"));
+    REQUIRE_THROWS_WITH(mgf("m a = zz\n", true), Contains("t.mgf:1: undefined material 'zz'"));
+    REQUIRE_THROWS_WITH(mgf("v q\n", true), Contains("t.mgf:1: undefined vertex 'q'"));
+    REQUIRE_THROWS_WITH(mgf("c\n cmix 1 red\n", true), Contains("undefined colour 'red'"));
     REQUIRE_THROWS_WITH(mgf("m w =\n rd 0.5\n"), Contains("no surfaces"));
 }
 

@@ -375,7 +375,7 @@ private:
         if (line.size() < 2 || line.size() > 4 || (line.size() >= 3 && line[2] != "="))
             line.fail("'v' needs a name, then '=' and an optional template: v NAME [= [TEMPLATE]]");
         if (line.size() == 2) {
-            if (!vertices_.count(line[1])) line.fail("undefined vertex " + in_quotes(line[1]));
+            vertex_named(line, line[1]);
             vertex_ = line[1];
             return;
         }
@@ -385,10 +385,18 @@ private:
         vertex_ = line[1];
     }
 
-    const MgfVertex& vertex_named(const Line& line, const std::string& name) const {
-        auto it = vertices_.find(name);
-        if (it == vertices_.end()) line.fail("undefined vertex " + in_quotes(name));
+    /// The entry `name` of one of the named contexts (vertices, colours, materials), or an
+    /// InputError at `line` ("undefined colour 'x'").
+    template <class Map>
+    static const typename Map::mapped_type& named(const Map& map, const Line& line,
+                                                  const std::string& name, const char* what) {
+        auto it = map.find(name);
+        if (it == map.end()) line.fail(std::string("undefined ") + what + " " + in_quotes(name));
         return it->second;
+    }
+
+    const MgfVertex& vertex_named(const Line& line, const std::string& name) const {
+        return named(vertices_, line, name, "vertex");
     }
 
     void vertex_part(const Line& line) {
@@ -417,18 +425,12 @@ private:
             return;
         }
         if (line.size() == 2) {
-            auto it = colours_.find(line[1]);
-            if (it == colours_.end()) line.fail("undefined colour " + in_quotes(line[1]));
-            colour_ = it->second;
+            colour_ = named(colours_, line, line[1], "colour");
             colour_name_ = line[1];
             return;
         }
         MgfColour c;
-        if (line.size() == 4) {
-            auto it = colours_.find(line[3]);
-            if (it == colours_.end()) line.fail("undefined colour " + in_quotes(line[3]));
-            c = it->second;
-        }
+        if (line.size() == 4) c = named(colours_, line, line[3], "colour");
         colours_[line[1]] = c;
         colour_ = c;
         colour_name_ = line[1];
@@ -469,9 +471,7 @@ private:
             double X = 0, Y = 0, Z = 0;
             for (size_t i = 1; i + 1 < line.size(); i += 2) {
                 const double w = parse_double(line, line[i], "cmix weight");
-                auto it = colours_.find(line[i + 1]);
-                if (it == colours_.end()) line.fail("undefined colour " + in_quotes(line[i + 1]));
-                const MgfColour& m = it->second;
+                const MgfColour& m = named(colours_, line, line[i + 1], "colour");
                 X += w * m.x / m.y;
                 Y += w;
                 Z += w * (1 - m.x - m.y) / m.y;
@@ -492,16 +492,12 @@ private:
             return;
         }
         if (line.size() == 2) {
-            if (!materials_.count(line[1])) line.fail("undefined material " + in_quotes(line[1]));
+            named(materials_, line, line[1], "material");
             material_ = line[1];
             return;
         }
         MgfMaterial m;
-        if (line.size() == 4) {
-            auto it = materials_.find(line[3]);
-            if (it == materials_.end()) line.fail("undefined material " + in_quotes(line[3]));
-            m = it->second;
-        }
+        if (line.size() == 4) m = named(materials_, line, line[3], "material");
         m.version = ++versions_;
         materials_[line[1]] = m;
         material_ = line[1];
