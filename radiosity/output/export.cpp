@@ -29,14 +29,23 @@ long ExportMesh::triangle_count() const {
     return n;
 }
 
-int export_resolution(const Surface& surface, const SplineField* field, int tessellation,
-                      int max_resolution) {
-    const int level = field && !field->empty() ? field->level() : 0;
+namespace {
+
+// export_resolution's rule for a field of `level`.
+int grid_intervals(const Surface& surface, int level, int tessellation, int max_resolution) {
     // 2^level intervals, twice; the level is at most the quadtree's depth, but guard the shift.
     long n = level >= 20 ? long(max_resolution) : 2L << level;
     n = std::max(n, 2L);
     if (surface.kind() != Surface::Kind::PlanarQuad) n = std::max(n, long(tessellation));
     return int(std::max(1L, std::min(n, long(max_resolution))));
+}
+
+}  // namespace
+
+int export_resolution(const Surface& surface, const SplineField* field, int tessellation,
+                      int max_resolution) {
+    const int level = field && !field->empty() ? field->level() : 0;
+    return grid_intervals(surface, level, tessellation, max_resolution);
 }
 
 namespace {
@@ -112,10 +121,7 @@ ExportMesh tessellate_for_export(const Scene& scene, const RadiosityView& view,
 
 Rgb display_colour(Rgb radiosity, double exposure) {
     Rgb out;
-    for (int c = 0; c < 3; ++c) {
-        const double v = exposure * radiosity[c] / Pi;
-        out[c] = std::isfinite(v) ? std::clamp(v, 0.0, 1.0) : 0.0;
-    }
+    for (int c = 0; c < 3; ++c) out[c] = clip_to_display(exposure * radiosity[c] / Pi);
     return out;
 }
 
@@ -207,10 +213,7 @@ Lightmap make_lightmap(const RadiosityView& view, int size, double exposure) {
     Image texels = bake_lightmap(view, m.layout);
     // tone_map's rule, in place: a 4096 x 4096 atlas is 400 MB of doubles, and a copy another.
     for (Rgb& p : texels.pixels)
-        for (int c = 0; c < 3; ++c) {
-            const double v = exposure * p[c];
-            p[c] = linear_to_srgb(std::isfinite(v) ? std::clamp(v, 0.0, 1.0) : 0.0);
-        }
+        for (int c = 0; c < 3; ++c) p[c] = linear_to_srgb(clip_to_display(exposure * p[c]));
     m.png = encode_png(texels);
     return m;
 }
@@ -220,11 +223,8 @@ double export_bytes(const Scene& scene, int lightmap_size) {
     const int level = std::max(scene.settings.max_depth, 5);
     double vertices = 0;
     for (const SceneSurface& s : scene.surfaces) {
-        const int n = std::min(
-            max_export_resolution,
-            std::max(
-                level >= 20 ? max_export_resolution : 2 << level,
-                s.surface.kind() == Surface::Kind::PlanarQuad ? 2 : scene.settings.tessellation));
+        const int n =
+            grid_intervals(s.surface, level, scene.settings.tessellation, max_export_resolution);
         vertices += double(n + 1) * double(n + 1);
     }
     // Per vertex: ExportVertex and two triangles' indices, the file's floats and indices (as

@@ -450,13 +450,16 @@ double linear_to_srgb(double linear) {
     return linear <= 0.0031308 ? 12.92 * linear : 1.055 * std::pow(linear, 1 / 2.4) - 0.055;
 }
 
+double clip_to_display(double linear) {
+    return std::isfinite(linear) ? std::clamp(linear, 0.0, 1.0) : 0.0;
+}
+
 Image tone_map(const Image& radiance, double exposure) {
     Image display(radiance.width, radiance.height);
     for (size_t p = 0; p < radiance.pixels.size(); ++p)
-        for (int c = 0; c < 3; ++c) {
-            const double v = exposure * radiance.pixels[p][c];
-            display.pixels[p][c] = linear_to_srgb(std::isfinite(v) ? std::clamp(v, 0.0, 1.0) : 0.0);
-        }
+        for (int c = 0; c < 3; ++c)
+            display.pixels[p][c] =
+                linear_to_srgb(clip_to_display(exposure * radiance.pixels[p][c]));
     return display;
 }
 

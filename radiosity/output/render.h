@@ -93,6 +93,10 @@ Image render_radiance(const Scene& scene, const Octree& octree, const RadiosityV
 /// The sRGB encoding function (IEC 61966-2-1): linear [0,1] to an encoded value in [0,1].
 double linear_to_srgb(double linear);
 
+/// A linear display value clipped to [0, 1], NaN and infinities to 0: what tone_map encodes,
+/// given exposure x radiance (the export's colours take it too, radiosity/output/export.h).
+double clip_to_display(double linear);
+
 /// Display values for write_png: exposure x radiance, clipped to [0,1] (NaN to 0), sRGB-encoded.
 Image tone_map(const Image& radiance, double exposure);
 
