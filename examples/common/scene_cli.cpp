@@ -278,16 +278,20 @@ void print_scene_warnings(std::ostream& os, const Scene& scene) {
     for (const SceneWarning& w : scene.warnings) os << "warning: " << w.text() << "\n";
 }
 
+void check_output_cost(const SceneRun& run, double bytes, const std::string& item,
+                       const std::string& doing, const std::string& lower) {
+    CostEstimate c = run.cost;
+    c.bytes += bytes;
+    c.detail += ", " + item + " " + format_bytes(bytes);
+    check_cost(c, run.memory_budget, describe_run(run) + doing, false, lower);
+}
+
 void check_render_cost(const SceneRun& run, const RenderOptions& options) {
     const Camera& camera = run.scene.camera;
-    const double image = render_bytes(camera.width, camera.height, options);
-    CostEstimate c = run.cost;
-    c.bytes += image;
-    c.detail += ", image " + format_bytes(image);
-    check_cost(c, run.memory_budget,
-               describe_run(run) + " rendered at " + std::to_string(camera.width) + " x " +
-                   std::to_string(camera.height),
-               false, "the depth or the camera's size");
+    check_output_cost(
+        run, render_bytes(camera.width, camera.height, options), "image",
+        " rendered at " + std::to_string(camera.width) + " x " + std::to_string(camera.height),
+        "the depth or the camera's size");
 }
 
 SceneRun read_scene_run(Args& args, const std::string& default_scene) {

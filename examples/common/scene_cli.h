@@ -41,6 +41,12 @@ struct SceneRun {
 /// exceeds the run's memory budget.
 void check_render_cost(const SceneRun& run, const RenderOptions& options);
 
+/// The same for any output that needs `bytes` beside the solve: `item` names it in the
+/// estimate's detail ("image", "export"), `doing` follows the run's description in the message
+/// (" rendered at 640 x 480"), `lower` says what to lower ("the depth or the camera's size").
+void check_output_cost(const SceneRun& run, double bytes, const std::string& item,
+                       const std::string& doing, const std::string& lower);
+
 /// The readers' warnings (Scene::warnings), one line each: "warning: " + SceneWarning::text().
 /// read_scene_run prints them on stderr once, right after loading, with --quiet too: they are
 /// about the input, not progress.

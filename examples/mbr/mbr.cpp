@@ -647,12 +647,8 @@ int export_command(Args& args) {
     }
 
     // The export's memory too, before the solve (as render's picture: check_render_cost).
-    CostEstimate cost = run.cost;
-    const double mesh_bytes = export_bytes(run.scene, lightmaps ? lightmap_size : 0);
-    cost.bytes += mesh_bytes;
-    cost.detail += ", export " + cell(mesh_bytes / (1 << 20), 1) + " MiB";
-    check_cost(cost, run.memory_budget, "exporting " + run.path, false,
-               "the depth" + std::string(lightmaps ? " or --lightmaps" : ""));
+    check_output_cost(run, export_bytes(run.scene, lightmaps ? lightmap_size : 0), "export",
+                      " exported", "the depth" + std::string(lightmaps ? " or --lightmaps" : ""));
 
     const bool report = !run.quiet && !is_standard_output(out) && !is_standard_output(save);
     std::ostringstream summary;
