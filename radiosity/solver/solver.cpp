@@ -32,6 +32,25 @@ double channel_sum(Rgb c) {
     return c.r + c.g + c.b;
 }
 
+/// For each j, the sum of values[k] over k != j: the sum before j plus the sum after it, not the
+/// total minus values[j] (which a floor of 1e16 beside a 1 x 1 lamp cancels to zero: 1e16 + 1
+/// rounds to 1e16). Linear in the values.
+template <class T>
+std::vector<T> sums_of_the_others(const std::vector<T>& values) {
+    std::vector<T> out(values.size());
+    T before{};
+    for (size_t j = 0; j < values.size(); ++j) {
+        out[j] = before;
+        before += values[j];
+    }
+    T after{};
+    for (size_t j = values.size(); j-- > 0;) {
+        out[j] += after;
+        after += values[j];
+    }
+    return out;
+}
+
 long peak_memory_bytes() {
     rusage usage{};
     getrusage(RUSAGE_SELF, &usage);
@@ -700,54 +719,31 @@ std::vector<Rgb> ProgressiveSolver::ambient_correction() const {
         rho[i] = scene_.material_of(i).reflectance.mean();
         area[i] = scene_.surfaces[i].surface.area();
     }
-    // The area of the surfaces other than j, summed without j (not total - area_j, which a
-    // floor of 1e16 beside a 1 x 1 lamp cancels to zero: 1e16 + 1 rounds to 1e16), so that
-    // a surface's share never divides by zero.
-    std::vector<double> others(n, 0.0);
-    {
-        double before = 0;
-        for (int j = 0; j < n; ++j) {
-            others[j] = before;
-            before += area[j];
-        }
-        double after = 0;
-        for (int j = n - 1; j >= 0; --j) {
-            others[j] += after;
-            after += area[j];
-        }
-    }
+    // The area of the surfaces other than j, summed without j, so that a surface's share never
+    // divides by zero.
+    const std::vector<double> others = sums_of_the_others(area);
+    // The measured fraction of shooter j's shot power that reached i (j has shot).
     auto coupling = [&](int j, int i) -> Rgb {
-        if (!coupling_[j].empty()) {
-            Rgb f;
-            for (int c = 0; c < 3; ++c)
-                f[c] = shot_power_[j][c] > 0 ? coupling_[j][i][c] / shot_power_[j][c] : 0.0;
-            return f;
-        }
-        const double f = i == j || others[j] <= 0 ? 0.0 : area[i] / others[j];
-        return {f, f, f};
+        Rgb f;
+        for (int c = 0; c < 3; ++c)
+            f[c] = shot_power_[j][c] > 0 ? coupling_[j][i][c] / shot_power_[j][c] : 0.0;
+        return f;
     };
     // A surface that never shot sends area_i / others_j of X_j to every other surface i: its
     // part of what reaches i is area_i times the sum over the other such j of X_j / others_j,
-    // taken for every i at once from prefix and suffix sums (linear in the surfaces, and no
-    // subtraction of i's own term to cancel). Only the surfaces that shot have a row of their
-    // own to visit.
+    // for every i at once (sums_of_the_others: linear in the surfaces). Only the surfaces that
+    // shot have a row of their own to visit.
     std::vector<int> shot;
     for (int j = 0; j < n; ++j)
         if (!coupling_[j].empty()) shot.push_back(j);
-    std::vector<Rgb> X = U, gain(n), spread_before(n), spread_after(n);
+    std::vector<Rgb> X = U, gain(n), share(n);
     for (int iteration = 0; iteration < 1000; ++iteration) {
         double change = 0, size = 0;
-        Rgb before, after;
-        for (int j = 0; j < n; ++j) {
-            spread_before[j] = before;
-            if (coupling_[j].empty() && others[j] > 0) before += (1 / others[j]) * X[j];
-        }
-        for (int j = n - 1; j >= 0; --j) {
-            spread_after[j] = after;
-            if (coupling_[j].empty() && others[j] > 0) after += (1 / others[j]) * X[j];
-        }
+        for (int j = 0; j < n; ++j)
+            share[j] = coupling_[j].empty() && others[j] > 0 ? (1 / others[j]) * X[j] : Rgb{};
+        const std::vector<Rgb> spread = sums_of_the_others(share);
         for (int i = 0; i < n; ++i) {
-            Rgb arriving = area[i] * (spread_before[i] + spread_after[i]);
+            Rgb arriving = area[i] * spread[i];
             for (int j : shot) arriving += coupling(j, i) * X[j];
             gain[i] = rho[i] * arriving;
         }
