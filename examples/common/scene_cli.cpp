@@ -461,6 +461,10 @@ void print_summary(std::ostream& os, const SceneRun& run, const SolveStats& st) 
         os << "shadows auto: the paper's fractions for " << st.paper_transfers << " of "
            << st.transfers << " transfers (more than " << run.options.exact_shadow_surfaces
            << " occluding surfaces between the pair), exact visibility for the rest\n";
+    if (st.weak_transfers > 0)
+        os << "weak transfers: " << st.weak_transfers << " of " << st.transfers
+           << " (every root sample below " << cell_g(run.options.receiver.weak_transfer, 3)
+           << " tolerances) took the polynomial through their root's samples\n";
 }
 
 double write_render(const SceneRun& run, const Solution& solution, const std::string& path,

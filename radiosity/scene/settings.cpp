@@ -143,6 +143,11 @@ std::vector<OptionSpec> make_option_table() {
                        "receiver cells that touch a planar shooter (within half their size: "
                        "shared edges, a block standing on the floor) split down to at least "
                        "this level, whatever the oracle says"),
+        real_option("weak_transfer", &S::weak_transfer, 0, 1000, false, false, "w",
+                    "a transfer whose m x m samples over the whole receiver are all below w "
+                    "absolute tolerances keeps the root as its only cell and takes the "
+                    "polynomial through them (no edgefill, no extrapolated ring); 0: the full "
+                    "pipeline for every transfer"),
         choice_option("contact_oracle", &S::contact_oracle, {"interpolation", "means"},
                       "the oracle's test in receiver cells that touch a planar shooter: the "
                       "polynomial through the m^2 samples predicting the others (follows B at "

@@ -75,6 +75,8 @@ struct SolverSettings {
     int contact_depth = 2;  // receiver cells touching a planar shooter split to at
                             //   least this level (0: off)
     ContactOracleSetting contact_oracle = ContactOracleSetting::Means;
+    double weak_transfer = 0.3;  // a transfer whose root samples are below this many
+                                 //   tolerances takes the level-0 field through them (0: off)
     TextureFieldSetting texture_field = TextureFieldSetting::Irradiance;
     FractionRaysSetting fraction_rays = FractionRaysSetting::Kernel;
 };

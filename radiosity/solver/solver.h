@@ -101,6 +101,7 @@ struct ShotStats {
                                //   sum of channels
     long rays = 0;             // shadow rays
     int paper_transfers = 0;   // transfers that took the paper's fractions under shadows auto
+    int weak_transfers = 0;    // transfers the weak transfer rule kept at the root
     int finest_level = 0;      // finest level of its results
     double seconds = 0;
 };
@@ -118,6 +119,7 @@ struct SolveStats {
     long analytic_evals = 0;   // closed-form form factors (ShotStats::analytic_evals)
     long transfers = 0;        // of all shots (ShotStats::receivers)
     long paper_transfers = 0;  //   of which with the paper's fractions under shadows auto
+    long weak_transfers = 0;   //   of which weak transfers (ShotStats::weak_transfers)
     double ambient_power = 0;  // power the ambient correction added (sum of channels)
     double limited_power = 0;  // the limiter's change of the reflected power, all shots (<= 0)
     std::vector<ShotStats> per_shot;

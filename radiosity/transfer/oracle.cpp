@@ -12,6 +12,8 @@
 #include "math/parallel.h"
 #include "math/polynomial.h"
 #include "radiosity/transfer/gauss_points.h"
+#include "radiosity/transfer/scale_adjustment.h"
+#include "radiosity/transfer/weak_transfer.h"
 
 namespace mbr {
 
@@ -33,7 +35,7 @@ struct Oracle {
 /// The mean of dB over a cell with an n x n rule; counts its (21) evaluations and, when asked,
 /// keeps the largest sample.
 Rgb cell_mean(IncrementSampler& sampler, const Rect& r, const GaussLegendre& rule, int thread,
-              long* evals, long* increments, double* largest = nullptr) {
+              long* evals, long* increments, double* largest = nullptr, Rgb* values = nullptr) {
     Rgb sum;
     double s[16], t[16];
     gauss_points(r, rule, s, t);
@@ -41,6 +43,7 @@ Rgb cell_mean(IncrementSampler& sampler, const Rect& r, const GaussLegendre& rul
         for (int b = 0; b < rule.n(); ++b) {
             const Rgb v = sampler.sample(s[a], t[b], thread, evals);
             if (largest) *largest = std::max(*largest, max_abs(v));
+            if (values) values[a * rule.n() + b] = v;
             sum += (0.25 * rule.w[a] * rule.w[b]) * v;
             ++*increments;
         }
@@ -218,10 +221,20 @@ void subdivide_by_oracle(ReceiverState& state, IncrementSampler& sampler) {
     // (not needed when the bounds leave the oracle nothing to decide).
     if (opt.min_depth < opt.max_depth) {
         long evals = 0, increments = 0;
-        cell_mean(sampler, Rect{0, 1, 0, 1}, o.rule_m, 0, &evals, &increments, &o.scale);
+        std::vector<Rgb> root(size_t(m) * m);  // [a * m + b], as sample_leaves stores them
+        cell_mean(sampler, Rect{0, 1, 0, 1}, o.rule_m, 0, &evals, &increments, &o.scale,
+                  root.data());
         stats.n_kernel_evals += evals;
         stats.n_increments += increments;
         stats.n_oracle_increments += increments;
+        // The weak transfer rule (weak_transfer.h): below the threshold, with the shooter far
+        // enough for these samples to stand for the receiver, the root stays the only leaf.
+        if (is_weak_transfer(opt, o.scale) &&
+            root_samples_represent(*sampler.shooter().surface, *sampler.receiver().surface)) {
+            stats.weak = true;
+            store_leaf_samples(state, forest.domain_root(), root.data());
+            return;
+        }
     }
     o.min_depth = weak_receiver_min_depth(opt, o.scale);
     // The shooter's plane when it is planar (the contact rule).

@@ -118,6 +118,10 @@ struct ReceiverOptions {
                                     //   `set contact_oracle`)
     double weak_receiver = 0;       // > 0: a receiver whose root samples are all below this
                                     //   many absolute tolerances starts the oracle at depth 0
+    double weak_transfer = 0;       // > 0: a transfer whose root samples are all below this
+                                    //   many absolute tolerances keeps the root as its only
+                                    //   leaf and takes the level-0 field through its samples
+                                    //   (weak_transfer.h: no edgefill, no ring)
     double absolute_tolerance = 0;  // radiosity below which differences never refine: the
                                     //   oracle, edgefill and shadow tests use the larger of
                                     //   their relative tolerance and this, and the truncation
@@ -147,6 +151,7 @@ struct TransferStats {
     long n_rays = 0;                 // shadow rays (fractions (28), or per node on curved shooters)
     int n_fractions = 0;             // fractions (28) evaluated
     int n_shadow_splits = 0;         // leaves split by shadow subdivision (and scale adjustment)
+    bool weak = false;               // the weak transfer rule kept the root (weak_transfer.h)
     double seconds_sampling = 0, seconds_boundary = 0, seconds_expanded = 0, seconds_projection = 0,
            seconds_shadows = 0, seconds_total = 0;
 };

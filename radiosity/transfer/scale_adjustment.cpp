@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <vector>
 
+#include "math/check.h"
 #include "math/gauss_legendre.h"
 #include "math/parallel.h"
 #include "math/polynomial.h"
@@ -56,6 +57,23 @@ int adjust_neighbour_scales(Forest& forest, Forest::Region region) {
     return n_splits;
 }
 
+namespace {
+
+/// max_sample and the per-channel range [sample_lo, sample_hi] widened by one leaf's m x m
+/// samples.
+void widen_sample_range(ReceiverState& state, const Rgb* samples) {
+    const int m = state.options.m;
+    for (int i = 0; i < m * m; ++i) {
+        state.max_sample = std::max(state.max_sample, max_abs(samples[i]));
+        for (int k = 0; k < 3; ++k) {
+            state.sample_lo[k] = std::min(state.sample_lo[k], samples[i][k]);
+            state.sample_hi[k] = std::max(state.sample_hi[k], samples[i][k]);
+        }
+    }
+}
+
+}  // namespace
+
 void sample_leaves(ReceiverState& state, IncrementSampler& sampler) {
     const int m = state.options.m;
     const GaussLegendre rule = gauss_legendre(m);
@@ -86,15 +104,18 @@ void sample_leaves(ReceiverState& state, IncrementSampler& sampler) {
         state.stats.n_kernel_evals += evals[c];
         state.stats.n_increments += long(m) * m;
         state.stats.n_unconverged += unconverged[c];
-        const Rgb* out = &state.samples[size_t(state.forest.node(todo[c]).samples) * m * m];
-        for (int i = 0; i < m * m; ++i) {
-            state.max_sample = std::max(state.max_sample, max_abs(out[i]));
-            for (int k = 0; k < 3; ++k) {
-                state.sample_lo[k] = std::min(state.sample_lo[k], out[i][k]);
-                state.sample_hi[k] = std::max(state.sample_hi[k], out[i][k]);
-            }
-        }
+        widen_sample_range(state,
+                           &state.samples[size_t(state.forest.node(todo[c]).samples) * m * m]);
     }
+}
+
+void store_leaf_samples(ReceiverState& state, int index, const Rgb* values) {
+    const int m = state.options.m;
+    Forest::Node& node = state.forest.node(index);
+    MBR_CHECK_MSG(node.is_leaf() && node.samples < 0, "cell " << node.cell << " has samples");
+    node.samples = static_cast<int>(state.samples.size() / (size_t(m) * m));
+    state.samples.insert(state.samples.end(), values, values + size_t(m) * m);
+    widen_sample_range(state, values);
 }
 
 void sample_split_leaves(ReceiverState& state) {

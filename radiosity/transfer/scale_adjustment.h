@@ -19,6 +19,11 @@ int adjust_neighbour_scales(Forest& forest, Forest::Region region);
 /// none yet.
 void sample_leaves(ReceiverState& state, IncrementSampler& sampler);
 
+/// Gives the leaf `index` (without samples yet) the m x m samples `values` ([a * m + b] at
+/// (s_a, t_b) of its Gauss-Legendre nodes, as sample_leaves takes them) and widens the state's
+/// sample range by them.
+void store_leaf_samples(ReceiverState& state, int index, const Rgb* values);
+
 /// Samples for leaves made after stage 4 (shadow subdivision and its scale adjustment): a domain
 /// leaf gets its parent's tensor polynomial resampled (and is marked `resampled`), an expanded
 /// leaf the extrapolation.

@@ -90,28 +90,39 @@ SplineField transfer(const Shooter& shooter, const ReceiverSurface& receiver,
             state.rhombus_radius = rhombus_radius_for_samples(state, dn);
             stats.rhombus_radius = state.rhombus_radius;
         }
-        {
-            const StageTimer timer(stats.seconds_boundary);
-            fill_boundary(state, sampler);  // stage 3, eq. (22)
-        }
-        {
-            const StageTimer timer(stats.seconds_expanded);
-            if (!fine_grid) expand_domain(state, sampler);  // stage 4, (23)-(27)
-        }
-        {
-            const StageTimer timer(stats.seconds_projection);
-            state.fulcrums = select_fulcrums(state.forest, options.m);  // stage 5
-            stats.n_fulcrums = static_cast<int>(state.fulcrums.size());
-            if (!fine_grid) project_in_rhombi(state, dn);  // stage 6, eq. (19)
-        }
-        {
+        if (stats.weak) {
+            // The weak transfer rule kept the root alone (weak_transfer.h): stages 3-8 at level 0.
+            {
+                const StageTimer timer(stats.seconds_projection);
+                result = project_root_polynomial(state);
+            }
             const StageTimer timer(stats.seconds_shadows);
-            if (shadows == ShadowMethod::Fractions) apply_shadows(state, sampler, dn);  // 7, (28)
-        }
-        {
-            const StageTimer timer(stats.seconds_projection);
-            result = fine_grid ? project_fine_grid(state, dn)  // stages 6 and 8
-                               : unify_scales(state, dn);      // stage 8, eq. (17)
+            if (shadows == ShadowMethod::Fractions) mask_root_coefficients(result, state, sampler);
+        } else {
+            {
+                const StageTimer timer(stats.seconds_boundary);
+                fill_boundary(state, sampler);  // stage 3, eq. (22)
+            }
+            {
+                const StageTimer timer(stats.seconds_expanded);
+                if (!fine_grid) expand_domain(state, sampler);  // stage 4, (23)-(27)
+            }
+            {
+                const StageTimer timer(stats.seconds_projection);
+                state.fulcrums = select_fulcrums(state.forest, options.m);  // stage 5
+                stats.n_fulcrums = static_cast<int>(state.fulcrums.size());
+                if (!fine_grid) project_in_rhombi(state, dn);  // stage 6, eq. (19)
+            }
+            {
+                const StageTimer timer(stats.seconds_shadows);
+                if (shadows == ShadowMethod::Fractions)
+                    apply_shadows(state, sampler, dn);  // 7, (28)
+            }
+            {
+                const StageTimer timer(stats.seconds_projection);
+                result = fine_grid ? project_fine_grid(state, dn)  // stages 6 and 8
+                                   : unify_scales(state, dn);      // stage 8, eq. (17)
+            }
         }
         state.mask = nullptr;  // it refers to the sampler, which ends here
         stats.n_rays += sampler.n_rays();

@@ -25,6 +25,9 @@
 //                                                   Computation", section 6 "Shadow", (28)
 //   8 unify_scales             unification.h       "Scale Unification and Superposition", (17)
 //   6+8 project_fine_grid      fine_grid.h         beyond the paper (unify_by_projection)
+//   3-8 project_root_polynomial weak_transfer.h   beyond the paper: a weak transfer (its root
+//                                                   samples below weak_transfer tolerances)
+//                                                   keeps the root and takes its polynomial
 //
 // Visibility: with ShadowMethod::Fractions (the paper's) stage 7 masks the coefficients; with
 // ShadowMethod::Exact the samples of (21) already carry it (radiosity/visibility/visible_parts.h).
@@ -44,6 +47,7 @@
 #include "radiosity/transfer/scale_adjustment.h"
 #include "radiosity/transfer/shadows.h"
 #include "radiosity/transfer/unification.h"
+#include "radiosity/transfer/weak_transfer.h"
 #include "radiosity/visibility/occlusion.h"
 
 namespace mbr {
