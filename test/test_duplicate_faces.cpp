@@ -403,10 +403,12 @@ TEST_CASE("duplicate faces: mbr prints the warning once, with --quiet too", "[du
         CAPTURE(quiet, run);
         REQUIRE(run.status == 0);
         // One line: "warning: FILE:5: surface 'back' repeats surface 'room.zmax' (FILE:3) ...".
+        // Lines of duplicate warnings (two shots leave power unshot, and the summary's own
+        // warning about that is not counted).
         size_t n = 0;
         for (size_t at = run.err.find("warning: "); at != std::string::npos;
              at = run.err.find("warning: ", at + 1))
-            ++n;
+            if (run.err.find("repeats surface", at) < run.err.find('\n', at)) ++n;
         CHECK(n == 1);
         CHECK_THAT(run.err, Contains("warning: " + scene +
                                      ":5: surface 'back' repeats surface "

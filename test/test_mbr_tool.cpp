@@ -831,9 +831,16 @@ TEST_CASE("mbr_tool: the summary says why the solve stopped, and the total left 
     const std::string converged = summary({"--convergence", "0.5"});
     CHECK_THAT(converged,
                Contains(", stopped: largest unshot share below the convergence threshold, "));
-    CHECK_THAT(summary({"--max-shots", "1", "--ambient", "off"}),
-               Contains("(no ambient correction)"));
+    const std::string no_ambient = summary({"--max-shots", "1", "--ambient", "off"});
+    CHECK_THAT(no_ambient, Contains("(no ambient correction)"));
     CHECK_THAT(limited, !Contains("converged"));
+    // More than 1 % unshot under the ambient correction: a warning says where it falls is not
+    // known (without the correction the missing light is plain to see in the figure).
+    CHECK_THAT(limited, Contains("% of the power is still unshot; the ambient correction "
+                                 "restores its total, not where it falls"));
+    CHECK_THAT(no_ambient, !Contains("is still unshot"));
+    CHECK_THAT(summary({"--convergence", "1e-9", "--max-shots", "40"}),
+               !Contains("is still unshot"));
 }
 
 TEST_CASE("mbr_tool: the picture's memory is in the estimate, said before the solve",
