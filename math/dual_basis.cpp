@@ -226,11 +226,12 @@ double DualTable::truncation_radius(double eps) const {
 double DualTable::rhombus_radius(double eps) const {
     const double threshold = eps * max_abs_ * max_abs_;
     const int n = static_cast<int>(envelope_.size());
-    // Smallest grid index whose envelope is at or below v.
+    // Smallest grid index whose envelope is at or below v (the envelope does not increase: a
+    // binary search; n - 1 when none is).
     auto first_below = [&](double v) {
-        for (int q = 0; q < n; ++q)
-            if (envelope_[q] <= v) return q;
-        return n - 1;
+        const auto it = std::partition_point(envelope_.begin(), envelope_.end(),
+                                             [v](double e) { return e > v; });
+        return std::min(static_cast<int>(it - envelope_.begin()), n - 1);
     };
     double r = 0;
     for (int q = 0; q < n; ++q) {
