@@ -834,13 +834,28 @@ TEST_CASE("mbr_tool: the summary says why the solve stopped, and the total left 
     const std::string no_ambient = summary({"--max-shots", "1", "--ambient", "off"});
     CHECK_THAT(no_ambient, Contains("(no ambient correction)"));
     CHECK_THAT(limited, !Contains("converged"));
-    // More than 1 % unshot under the ambient correction: a warning says where it falls is not
-    // known (without the correction the missing light is plain to see in the figure).
-    CHECK_THAT(limited, Contains("% of the power is still unshot; the ambient correction "
-                                 "restores its total, not where it falls"));
+    // More than 5 % unshot under the gathered ambient correction, more than 1 % under the
+    // constant one: a warning says how far its placement goes (without the correction the
+    // missing light is plain to see in the figure).
+    CHECK_THAT(limited, Contains("% of the power is still unshot; the ambient gather places it "
+                                 "with one level-0 field per surface"));
+    const std::string constant = summary({"--max-shots", "1", "--ambient-rays", "0"});
+    CHECK_THAT(constant, Contains("% of the power is still unshot; the ambient correction "
+                                  "restores its total, not where it falls"));
     CHECK_THAT(no_ambient, !Contains("is still unshot"));
     CHECK_THAT(summary({"--convergence", "1e-9", "--max-shots", "40"}),
                !Contains("is still unshot"));
+    // The light reflects nothing here, so the correction adds nothing and says nothing; with a
+    // reflecting light the floor's unshot power comes back to it, and the summary says how.
+    CHECK_THAT(limited, !Contains("ambient correction: "));
+    std::string reflecting = lit_floor_scene;
+    reflecting.replace(reflecting.find("light reflectance 0 0 0"), 23,
+                       "light reflectance 0.5 0.5 0.5");
+    write_text(scene, reflecting);
+    CHECK_THAT(summary({"--max-shots", "1"}),
+               Contains(" % of the emitted power added, gathered by "));
+    CHECK_THAT(summary({"--max-shots", "1", "--ambient-rays", "0"}),
+               Contains(" % of the emitted power added, a constant per surface"));
 }
 
 TEST_CASE("mbr_tool: the picture's memory is in the estimate, said before the solve",

@@ -465,16 +465,27 @@ void print_summary(std::ostream& os, const SceneRun& run, const SolveStats& st) 
         os << "weak transfers: " << st.weak_transfers << " of " << st.transfers
            << " (every root sample below " << cell_g(run.options.receiver.weak_transfer, 3)
            << " tolerances) took the polynomial through their root's samples\n";
-    // DESIGN: the ambient correction restores the unshot power's total but places it as one
-    // constant per surface; beyond about 1 % unshot single points go wrong by several per cent
-    // (cube.mgf: 1.4 % unshot, 2.9 % mean error at 196 random points; 5.9 %, 15.4 %;
-    // docs/method.md, "Weak transfers").
+    if (run.options.ambient && st.ambient_power > 0)
+        os << "ambient correction: " << cell_g(percent_of_emitted(st.ambient_power, st), 4)
+           << " % of the emitted power added"
+           << (st.ambient_rays > 0 ? ", gathered by " + std::to_string(st.ambient_rays) +
+                                         " rays in " + cell(st.ambient_seconds, 2) + " s"
+                                   : std::string(", a constant per surface"))
+           << "\n";
+    // DESIGN: the constant ambient correction restores the unshot power's total but not where
+    // it falls; beyond about 1 % unshot single points go wrong by several per cent (cube.mgf:
+    // 1.4 % unshot, 2.9 % mean error at 196 random points; 5.9 %, 15.4 %). The gather places
+    // it, but as one level-0 field per surface: at 5.9 % unshot cube.mgf reads 1.3 % mean and
+    // 34 % at its darkest points (docs/method.md, "The ambient correction").
     const double unshot = percent_of_emitted(st.unshot_power, st);
-    if (run.options.ambient && unshot > 1)
-        os << "warning: " << cell_g(unshot, 3)
-           << " % of the power is still unshot; the ambient correction restores its total, not "
-              "where it falls, so single points may be off by more than that (raise --max-shots "
-              "or lower --convergence for the right light)\n";
+    const bool gathered = run.options.ambient_rays > 0;
+    if (run.options.ambient && unshot > (gathered ? 5 : 1))
+        os << "warning: " << cell_g(unshot, 3) << " % of the power is still unshot; "
+           << (gathered ? "the ambient gather places it with one level-0 field per surface, so "
+                          "its shadows are soft and dark points may be off by more than that"
+                        : "the ambient correction restores its total, not where it falls, so "
+                          "single points may be off by more than that")
+           << " (raise --max-shots or lower --convergence for the right light)\n";
 }
 
 double write_render(const SceneRun& run, const Solution& solution, const std::string& path,

@@ -127,6 +127,11 @@ std::vector<OptionSpec> make_option_table() {
         switch_option("ambient", &S::ambient,
                       "at the end, the power still unshot is sent on through the measured "
                       "coupling of the surfaces (an ambient term)"),
+        integer_option("ambient_rays", &S::ambient_rays, 0, 4096, "R",
+                       "the ambient correction is gathered at each surface's m x m Gauss points "
+                       "by this many cosine-distributed rays, fewer when all of them would pass "
+                       "16.8 M (the unshot light lands where it falls, shadows included); 0: a "
+                       "constant radiosity per surface"),
         switch_option("limiter", &S::limiter,
                       "where a shot's increment rings above rho_max x the shooter's largest "
                       "coefficient its covering coefficients are clipped to that bound, and "

@@ -84,8 +84,10 @@ CostEstimate scene_cost(const Scene& scene, const SolverOptions& options, int th
     // each in its surface's order; a transfer's scratch at the largest order in use.
     double fields = 0, seconds = 0;
     int m = 0;
+    std::vector<int> orders;
     for (int i = 0; i < static_cast<int>(scene.surfaces.size()); ++i) {
         const int mi = surface_order(scene, i, options.receiver.m);
+        orders.push_back(mi);
         fields += 3 * field_bytes(mi, d);
         seconds += transfer_seconds(mi, d);  // one shot's transfers, each a full tree
         m = std::max(m, mi);
@@ -138,9 +140,13 @@ CostEstimate scene_cost(const Scene& scene, const SolverOptions& options, int th
             : std::min(double(max_cached_candidates), pairs * (polygons / bytes_per_polygon)) *
                       sizeof(int) +
                   pairs * 96.0;
+    // The ambient gather's rays at the end (ambient_gather.h).
+    const double gather = options.ambient && options.ambient_rays > 0
+                              ? ambient_gather_bytes(orders, options.ambient_rays)
+                              : 0.0;
     CostEstimate c;
-    c.bytes =
-        program_bytes + fields + hidden + transfers + caches + polygons + textures + occluder_lists;
+    c.bytes = program_bytes + fields + hidden + transfers + caches + polygons + textures +
+              occluder_lists + gather;
     c.setup_seconds = options.hidden_regions ? texels / (hidden_resolution * hidden_resolution) *
                                                    hidden_seconds_per_surface
                                              : 0.0;
@@ -148,8 +154,9 @@ CostEstimate scene_cost(const Scene& scene, const SolverOptions& options, int th
     c.detail = "program " + format_bytes(program_bytes) + ", fields " + format_bytes(fields) +
                ", hidden regions " + format_bytes(hidden) + ", transfers " +
                format_bytes(transfers) + ", quadrature caches " + format_bytes(caches) +
-               ", occluder lists " + format_bytes(occluder_lists) + ", polygons " +
-               format_bytes(polygons) + ", textures " + format_bytes(textures);
+               ", occluder lists " + format_bytes(occluder_lists) + ", ambient gather " +
+               format_bytes(gather) + ", polygons " + format_bytes(polygons) + ", textures " +
+               format_bytes(textures);
     return c;
 }
 

@@ -199,6 +199,7 @@ SolverOptions solver_options(const SolverSettings& s) {
     o.self_transfer = s.self_transfer;
     o.tolerance = s.tolerance;
     o.ambient = s.ambient;
+    o.ambient_rays = s.ambient_rays;
     o.limiter = s.limiter;
     o.irradiance_fields = s.texture_field == TextureFieldSetting::Irradiance;
     o.hidden_regions = s.hidden;
@@ -771,7 +772,22 @@ std::vector<Rgb> ProgressiveSolver::ambient_correction() const {
 Solution ProgressiveSolver::finish() {
     Solution out = solution_;
     SolveStats& st = out.stats;
-    if (options_.ambient) {
+    if (options_.ambient && options_.ambient_rays > 0) {
+        // The unshot power and its further bounces gathered where they fall.
+        std::vector<bool> irradiance;
+        for (size_t i = 0; i < out.radiosity.size(); ++i)
+            irradiance.push_back(!out.quantity.empty() &&
+                                 out.quantity[i] == FieldQuantity::irradiance);
+        const AmbientSources sources{solution_.unshot, order_, irradiance, hidden_};
+        const double gather_start = now();
+        const AmbientGather gather =
+            gather_ambient(scene_, octree_, sources, options_.ambient_rays);
+        st.ambient_seconds = now() - gather_start;
+        for (size_t i = 0; i < gather.added.size(); ++i)
+            if (!gather.added[i].empty()) out.radiosity[i].add(gather.added[i]);
+        st.ambient_power = gather.power;
+        st.ambient_rays = gather.rays;
+    } else if (options_.ambient) {
         const std::vector<Rgb> correction = ambient_correction();
         for (size_t i = 0; i < correction.size(); ++i) {
             if (max_abs(correction[i]) == 0) continue;

@@ -28,6 +28,7 @@
 #include "radiosity/geometry/radiosity_view.h"
 #include "radiosity/geometry/spline_field.h"
 #include "radiosity/scene/scene.h"
+#include "radiosity/solver/ambient_gather.h"
 #include "radiosity/solver/limiter.h"
 #include "radiosity/transfer/transfer.h"
 #include "radiosity/visibility/hidden_regions.h"
@@ -69,6 +70,9 @@ struct SolverOptions {
                                     //   over all its shots) and added as a constant radiosity per
                                     //   surface (Cohen et al. 1988's ambient term, with measured
                                     //   instead of area-weighted coupling)
+    int ambient_rays = 256;         //   gathered by this many rays at each surface's m x m Gauss
+                                    //   points (ambient_gather.h, gather_rays_per_point); 0: the
+                                    //   constant per surface
 };
 
 /// The scene's `set` statements as solver options (shadows: the scene's method and rays).
@@ -116,12 +120,14 @@ struct SolveStats {
     long peak_memory_bytes = 0;  // the process's peak resident memory
     long coefficients = 0;       // coefficients of the solved fields (all surfaces, per channel)
     long kernel_evals = 0, rays = 0;
-    long analytic_evals = 0;   // closed-form form factors (ShotStats::analytic_evals)
-    long transfers = 0;        // of all shots (ShotStats::receivers)
-    long paper_transfers = 0;  //   of which with the paper's fractions under shadows auto
-    long weak_transfers = 0;   //   of which weak transfers (ShotStats::weak_transfers)
-    double ambient_power = 0;  // power the ambient correction added (sum of channels)
-    double limited_power = 0;  // the limiter's change of the reflected power, all shots (<= 0)
+    long analytic_evals = 0;     // closed-form form factors (ShotStats::analytic_evals)
+    long transfers = 0;          // of all shots (ShotStats::receivers)
+    long paper_transfers = 0;    //   of which with the paper's fractions under shadows auto
+    long weak_transfers = 0;     //   of which weak transfers (ShotStats::weak_transfers)
+    double ambient_power = 0;    // power the ambient correction added (sum of channels)
+    long ambient_rays = 0;       //   and the rays its gather cast
+    double ambient_seconds = 0;  //   and the gather's wall time
+    double limited_power = 0;    // the limiter's change of the reflected power, all shots (<= 0)
     std::vector<ShotStats> per_shot;
 };
 

@@ -1,0 +1,197 @@
+// radiosity/solver/ambient_gather.cpp - the ambient correction gathered by rays
+// (ambient_gather.h).
+#include "radiosity/solver/ambient_gather.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "math/check.h"
+#include "math/gauss_legendre.h"
+#include "math/parallel.h"
+#include "radiosity/transfer/weak_transfer.h"
+#include "radiosity/visibility/occlusion.h"
+
+namespace mbr {
+
+namespace {
+
+/// The base-2 radical inverse of i (van der Corput): the bits of i mirrored about the point.
+double radical_inverse_2(std::uint32_t i) {
+    i = (i << 16) | (i >> 16);
+    i = ((i & 0x00ff00ffu) << 8) | ((i & 0xff00ff00u) >> 8);
+    i = ((i & 0x0f0f0f0fu) << 4) | ((i & 0xf0f0f0f0u) >> 4);
+    i = ((i & 0x33333333u) << 2) | ((i & 0xccccccccu) >> 2);
+    i = ((i & 0x55555555u) << 1) | ((i & 0xaaaaaaaau) >> 1);
+    return i * 0x1.0p-32;
+}
+
+/// The fractional part of x.
+double wrap01(double x) {
+    return x - std::floor(x);
+}
+
+bool nonzero(const SplineField& f) {
+    if (f.empty()) return false;
+    for (int c = 0; c < 3; ++c)
+        for (double a : f.channel(c).a)
+            if (a != 0) return true;
+    return false;
+}
+
+/// A kept ray's hit: the front face of `surface` at (u, v).
+struct GatherHit {
+    int surface;
+    float u, v;
+};
+
+/// Where the samples of all surfaces live in the flat arrays: surface i's m_i x m_i samples
+/// from first[i], sample (a, b) at first[i] + a m_i + b, at (s_a, t_b).
+std::vector<int> sample_offsets(const std::vector<int>& order) {
+    std::vector<int> first(order.size() + 1, 0);
+    for (size_t i = 0; i < order.size(); ++i) first[i + 1] = first[i] + order[i] * order[i];
+    return first;
+}
+
+}  // namespace
+
+int gather_rays_per_point(int rays, double samples) {
+    if (!(samples > 0) || double(rays) * samples <= ambient_max_rays) return rays;
+    return std::min(rays, std::max(ambient_min_rays, int(ambient_max_rays / samples)));
+}
+
+double ambient_gather_bytes(const std::vector<int>& order, int rays) {
+    double samples = 0;
+    for (int m : order) samples += double(m) * m;
+    rays = gather_rays_per_point(rays, samples);
+    return samples * (double(rays) * sizeof(GatherHit) + 6 * sizeof(Rgb) + sizeof(double) + 1);
+}
+
+AmbientGather gather_ambient(const Scene& scene, const Octree& octree,
+                             const AmbientSources& sources, int rays_asked, std::uint64_t seed) {
+    const int n = static_cast<int>(scene.surfaces.size());
+    MBR_CHECK_MSG(rays_asked >= 1, "ambient gather with " << rays_asked << " rays");
+    MBR_CHECK(int(sources.unshot.size()) == n && int(sources.order.size()) == n &&
+              int(sources.irradiance.size()) == n);
+    // U_j is read once per ray that meets j, by SplineField::evaluate (PolynomialPatches of
+    // fields at level 6 would hold 1.5 MiB a surface).
+    std::vector<bool> has_unshot(n);
+    for (int j = 0; j < n; ++j) has_unshot[j] = nonzero(sources.unshot[j]);
+
+    const Box3 box = octree.bounds();
+    const double scale = box.empty() ? 1.0 : length(box.extent());
+    const std::vector<int> first = sample_offsets(sources.order);
+    const int n_samples = first[n];
+    const int rays = gather_rays_per_point(rays_asked, n_samples);
+    auto surface_of = [&](int item) {
+        return int(std::upper_bound(first.begin(), first.end(), item) - first.begin()) - 1;
+    };
+    std::vector<GatherHit> hits(size_t(n_samples) * rays, GatherHit{-1, 0, 0});
+    std::vector<Rgb> first_bounce(n_samples);    // mean U_j(u, v) over the sample's rays
+    std::vector<Rgb> rho(n_samples);             // rho(s_a, t_b)
+    std::vector<double> weight(n_samples, 0.0);  // Gauss weight x A(s_a, t_b), for the power
+    std::vector<std::uint8_t> gathers(n_samples, 0);
+
+    // The rays, cast once: work items are samples, each with its own slots, so every sum below
+    // runs in a fixed order for any thread count.
+    parallel_for(n_samples, [&](int item) {
+        const int i = surface_of(item);
+        const int m = sources.order[i], k = item - first[i], a = k / m, b = k % m;
+        const Material& material = scene.material_of(i);
+        const GaussLegendre rule = gauss_legendre(m);
+        const double s = 0.5 * (rule.x[a] + 1), t = 0.5 * (rule.x[b] + 1);
+        const Surface& surface = scene.surfaces[i].surface;
+        weight[item] = 0.25 * rule.w[a] * rule.w[b] * surface.area_factor(s, t);
+        rho[item] = material.reflectance.value(s, t);
+        if (max_abs(material.reflectance.maximum()) == 0) return;  // reflects nothing
+        // A hidden point gathers at its substitute (hidden_regions.h), as every sample does.
+        const Vec2 q =
+            i < int(sources.hidden.size()) ? sources.hidden[i].substitute(s, t) : Vec2{s, t};
+        const SurfacePoint p = surface.evaluate(q.x, q.y);
+        if (!(p.area_factor > 0)) return;  // a degenerate point: nothing gathered
+        const Vec3 nz = p.normal;
+        const Vec3 helper = std::fabs(nz.x) < 0.9 ? Vec3{1, 0, 0} : Vec3{0, 1, 0};
+        const Vec3 nx = normalize(cross(helper, nz)), ny = cross(nz, nx);
+        // DESIGN: as find_hidden's rays, from the true surface 1e-7 of the scene in front.
+        const Vec3 origin = p.position + (1e-7 * scale) * nz;
+        const std::uint64_t key =
+            hash_seed(seed ^ 0x616d6269656e74ULL, std::uint64_t(i), std::uint64_t(k));
+        const double shift_1 = uniform01(key, 0), shift_2 = uniform01(key, 1);
+        GatherHit* kept = &hits[size_t(item) * rays];
+        Rgb sum;
+        for (int r = 0; r < rays; ++r) {
+            // Hammersley point r of `rays`, shifted (Cranley and Patterson 1976), lifted to the
+            // cosine-distributed hemisphere (density cos theta / pi).
+            const double u_1 = wrap01((r + 0.5) / rays + shift_1);
+            const double u_2 = wrap01(radical_inverse_2(std::uint32_t(r)) + shift_2);
+            const double phi = 2 * Pi * u_1, sin_theta = std::sqrt(u_2);
+            const double cos_theta = std::sqrt(std::max(0.0, 1 - u_2));
+            const Vec3 dir = (sin_theta * std::cos(phi)) * nx + (sin_theta * std::sin(phi)) * ny +
+                             cos_theta * nz;
+            const std::optional<Hit> hit =
+                octree.closest_hit(Ray{origin, dir, 0, HUGE_VAL}, RayFilter{-1, -1, true});
+            if (!hit || dot(octree.polygons()[hit->polygon].normal(), dir) > 0) continue;
+            kept[r] = {hit->surface, float(hit->uv.x), float(hit->uv.y)};
+            if (has_unshot[hit->surface])
+                sum += sources.unshot[hit->surface].evaluate(hit->uv.x, hit->uv.y);
+        }
+        first_bounce[item] = (1.0 / rays) * sum;
+        gathers[item] = 1;
+    });
+
+    // Jacobi: H = first bounce + mean R_j at the hits, R_i through rho H, from R = 0.
+    AmbientGather out;
+    std::vector<Rgb> H = first_bounce, reflected(n_samples);
+    auto added_power = [&]() {
+        double p = 0;
+        for (int item = 0; item < n_samples; ++item) {
+            reflected[item] = rho[item] * H[item];
+            p += weight[item] * (reflected[item].r + reflected[item].g + reflected[item].b);
+        }
+        return p;
+    };
+    double power = added_power();
+    out.iterations = 1;
+    std::vector<PolynomialPatches> bounce(n);
+    std::vector<bool> has_bounce(n, false);
+    while (out.iterations < ambient_max_iterations && power > 0) {
+        for (int i = 0; i < n; ++i) {
+            has_bounce[i] = false;
+            for (int item = first[i]; item < first[i + 1]; ++item)
+                has_bounce[i] = has_bounce[i] || max_abs(reflected[item]) > 0;
+            if (has_bounce[i])
+                bounce[i] = PolynomialPatches(
+                    polynomial_through_gauss_samples(sources.order[i], &reflected[first[i]]));
+        }
+        parallel_for(n_samples, [&](int item) {
+            if (!gathers[item]) return;
+            const GatherHit* kept = &hits[size_t(item) * rays];
+            Rgb sum;
+            for (int r = 0; r < rays; ++r)
+                if (kept[r].surface >= 0 && has_bounce[kept[r].surface])
+                    sum += bounce[kept[r].surface](kept[r].u, kept[r].v);
+            H[item] = first_bounce[item] + (1.0 / rays) * sum;
+        });
+        ++out.iterations;
+        const double next = added_power();
+        const bool settled = std::fabs(next - power) <= ambient_iteration_tolerance * next;
+        power = next;
+        if (settled) break;
+    }
+
+    out.power = power;
+    out.added.resize(n);
+    std::vector<Rgb> samples(n_samples);
+    for (int i = 0; i < n; ++i) {
+        bool any = false;
+        for (int item = first[i]; item < first[i + 1]; ++item) {
+            out.rays += gathers[item] ? rays : 0;
+            samples[item] = sources.irradiance[i] ? H[item] : reflected[item];
+            any = any || max_abs(samples[item]) > 0;
+        }
+        if (any)
+            out.added[i] = polynomial_through_gauss_samples(sources.order[i], &samples[first[i]]);
+    }
+    return out;
+}
+
+}  // namespace mbr

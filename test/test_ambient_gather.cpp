@@ -1,0 +1,185 @@
+// test/test_ambient_gather.cpp - the ambient correction gathered by rays (ambient_gather.h):
+// exact where the answer is known (a closed box of uniform unshot radiosity, a square's form
+// factor), independent of the thread count, and nearer the converged solution than the constant
+// per surface on the Cornell box stopped early.
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "radiosity/geometry/radiosity_view.h"
+#include "radiosity/scene/scene_io.h"
+#include "radiosity/scene/scene_octree.h"
+#include "radiosity/solver/ambient_gather.h"
+#include "radiosity/solver/solver.h"
+#include "radiosity/transfer/form_factor.h"
+#include "test/report.h"
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+using namespace mbr;
+
+namespace {
+
+Scene scene_from(const std::string& text) {
+    std::istringstream in(text);
+    return parse_scene(in, "test.scene");
+}
+
+/// Sources for gather_ambient: every surface of order 4, holding B, nothing hidden, and the
+/// unshot radiosity `unshot` (a constant) on the surfaces named in `shooting`.
+struct TestSources {
+    std::vector<SplineField> unshot;
+    std::vector<int> order;
+    std::vector<bool> irradiance;
+    std::vector<HiddenMask> hidden;
+    AmbientSources sources() const { return {unshot, order, irradiance, hidden}; }
+};
+TestSources sources_for(const Scene& scene, Rgb unshot, const std::vector<std::string>& shooting) {
+    TestSources s;
+    for (size_t i = 0; i < scene.surfaces.size(); ++i) {
+        bool shoots = false;
+        for (const std::string& name : shooting) shoots = shoots || scene.surfaces[i].name == name;
+        s.unshot.push_back(shoots ? SplineField::constant(4, 0, unshot) : SplineField());
+        s.order.push_back(4);
+        s.irradiance.push_back(false);
+    }
+    return s;
+}
+
+/// The m-point Gauss-Legendre nodes of [0,1] for m = 4, where the added field interpolates its
+/// samples.
+std::vector<double> gauss_nodes_01() {
+    const GaussLegendre rule = gauss_legendre(4);
+    std::vector<double> x;
+    for (int a = 0; a < 4; ++a) x.push_back(0.5 * (rule.x[a] + 1));
+    return x;
+}
+
+}  // namespace
+
+TEST_CASE("ambient gather: a closed box of uniform unshot radiosity gains U rho / (1 - rho)",
+          "[ambient]") {
+    // Every ray from inside a closed box meets a front face, all of them leaving U + R: the
+    // Jacobi iteration sums the geometric series rho + rho^2 + ... = rho / (1 - rho) = 1.
+    const Scene scene = scene_from(
+        "material white reflectance 0.5 0.5 0.5\n"
+        "box cube white  0 0 0  1 1 1  inward\n");
+    const Octree octree = build_octree(scene);
+    std::vector<std::string> all;
+    for (const SceneSurface& s : scene.surfaces) all.push_back(s.name);
+    const AmbientGather g =
+        gather_ambient(scene, octree, sources_for(scene, {1, 1, 1}, all).sources(), 16);
+    REQUIRE(g.added.size() == 6);
+    for (size_t i = 0; i < 6; ++i)
+        for (double s : {0.1, 0.5, 0.9})
+            for (double t : {0.2, 0.7}) {
+                CAPTURE(scene.surfaces[i].name, s, t);
+                CHECK(g.added[i].evaluate(s, t).g == Approx(1).epsilon(1e-3));
+            }
+    CHECK(g.power == Approx(6 * 3).epsilon(1e-3));  // six unit faces, three channels
+    CHECK(g.rays == 6 * 16 * 16);
+    CHECK(g.iterations > 5);
+    CHECK(g.iterations < ambient_max_iterations);
+}
+
+TEST_CASE("ambient gather: under an unshot square, rho times its point form factor", "[ambient]") {
+    // A black square of unshot radiosity 1 at height 1 above a receiver: one bounce only, the
+    // gathered H at each Gauss point is the point-to-square form factor.
+    const Scene scene = scene_from(
+        "material grey  reflectance 0.5 0.5 0.5\n"
+        "material black reflectance 0 0 0\n"
+        "rectangle floor grey    0 0 0   0 0 1   1 0 0\n"
+        "rectangle top   black   0 1 0   1 0 0   0 0 1\n");
+    const Octree octree = build_octree(scene);
+    const int floor = scene.find_surface("floor"), top = scene.find_surface("top");
+    REQUIRE(scene.surfaces[floor].surface.evaluate(0.5, 0.5).normal.y == Approx(1));
+    REQUIRE(scene.surfaces[top].surface.evaluate(0.5, 0.5).normal.y == Approx(-1));
+    const AmbientGather g =
+        gather_ambient(scene, octree, sources_for(scene, {1, 1, 1}, {"top"}).sources(), 4096);
+    CHECK(g.added[top].empty());  // black: gathers nothing
+    CHECK(g.iterations == 2);     // nothing reflected comes back
+    const std::vector<Vec3> square{{0, 1, 0}, {1, 1, 0}, {1, 1, 1}, {0, 1, 1}};
+    double worst = 0;
+    for (double s : gauss_nodes_01())
+        for (double t : gauss_nodes_01()) {
+            const SurfacePoint p = scene.surfaces[floor].surface.evaluate(s, t);
+            const double exact = 0.5 * point_polygon_form_factor(p.position, p.normal, square);
+            const double got = g.added[floor].evaluate(s, t).g;
+            worst = std::max(worst, std::fabs(got / exact - 1));
+        }
+    test::report() << "ambient gather, 4096 rays under a square: largest error " << 100 * worst
+                   << " %\n";
+    CHECK(worst < 0.015);  // 0.78 %
+}
+
+#ifdef _OPENMP
+TEST_CASE("ambient gather: results do not depend on the thread count", "[ambient]") {
+    const Scene scene =
+        load_scene(std::string(MBR_SOURCE_DIR) + "/examples/scenes/cornell_box.scene");
+    const Octree octree = build_octree(scene);
+    const TestSources held = sources_for(scene, {1, 0.5, 0.25}, {"light", "floor", "short_top"});
+    const AmbientSources sources = held.sources();
+    const int before = omp_get_max_threads();
+    omp_set_num_threads(1);
+    const AmbientGather one = gather_ambient(scene, octree, sources, 32);
+    omp_set_num_threads(2);
+    const AmbientGather two = gather_ambient(scene, octree, sources, 32);
+    omp_set_num_threads(before);
+    CHECK(one.power == two.power);
+    CHECK(one.iterations == two.iterations);
+    for (size_t i = 0; i < one.added.size(); ++i) {
+        CAPTURE(scene.surfaces[i].name);
+        REQUIRE(one.added[i].empty() == two.added[i].empty());
+        for (int c = 0; c < 3 && !one.added[i].empty(); ++c)
+            CHECK(one.added[i].channel(c).a == two.added[i].channel(c).a);
+    }
+}
+#endif
+
+TEST_CASE("ambient gather: the Cornell box stopped early lands nearer its converged solution",
+          "[ambient][solver]") {
+    // Stopped after a few shots, much of the power is unshot: the constant per surface restores
+    // its total, the gather puts it where it falls (the floor's shadows, the walls' corners).
+    const Scene scene =
+        load_scene(std::string(MBR_SOURCE_DIR) + "/examples/scenes/cornell_box.scene");
+    const Octree octree = build_octree(scene);
+    SolverOptions o = solver_options(scene.settings);
+    o.receiver.max_depth = 4;
+    const RadiosityView converged = radiosity_view(scene, solve(scene, octree, o));
+    o.max_shots = 6;
+    o.ambient_rays = 0;
+    const Solution constant = solve(scene, octree, o);
+    o.ambient_rays = 64;
+    const Solution gathered = solve(scene, octree, o);
+    const double unshot = constant.stats.unshot_power / constant.stats.emitted_power;
+    const RadiosityView constant_view = radiosity_view(scene, constant);
+    const RadiosityView gathered_view = radiosity_view(scene, gathered);
+    double e_constant = 0, e_gathered = 0, max_gathered = 0;
+    int count = 0;
+    for (size_t i = 0; i < scene.surfaces.size(); ++i)
+        for (int a = 0; a < 5; ++a)
+            for (int b = 0; b < 5; ++b) {
+                const double s = (a + 0.5) / 5, t = (b + 0.5) / 5;
+                const double ref = converged.at(int(i), s, t).g;
+                if (!(ref > 0)) continue;
+                e_constant += std::fabs(constant_view.at(int(i), s, t).g / ref - 1);
+                const double e = std::fabs(gathered_view.at(int(i), s, t).g / ref - 1);
+                e_gathered += e;
+                max_gathered = std::max(max_gathered, e);
+                ++count;
+            }
+    e_constant /= count;
+    e_gathered /= count;
+    test::report() << "Cornell box after 6 shots (" << 100 * unshot << " % unshot), mean error "
+                   << "against converged at " << count << " points: constant " << 100 * e_constant
+                   << " %, gathered " << 100 * e_gathered << " % (max " << 100 * max_gathered
+                   << " %), gathered power " << gathered.stats.ambient_power << " against "
+                   << constant.stats.ambient_power << "\n";
+    CHECK(unshot > 0.05);
+    CHECK(gathered.stats.ambient_rays > 0);
+    CHECK(e_gathered < 0.5 * e_constant);
+}
