@@ -71,19 +71,23 @@ TEST_CASE("ambient gather: a closed box of uniform unshot radiosity gains U rho 
     const Octree octree = build_octree(scene);
     std::vector<std::string> all;
     for (const SceneSurface& s : scene.surfaces) all.push_back(s.name);
-    const AmbientGather g =
-        gather_ambient(scene, octree, sources_for(scene, {1, 1, 1}, all).sources(), 16);
-    REQUIRE(g.added.size() == 6);
-    for (size_t i = 0; i < 6; ++i)
-        for (double s : {0.1, 0.5, 0.9})
-            for (double t : {0.2, 0.7}) {
-                CAPTURE(scene.surfaces[i].name, s, t);
-                CHECK(g.added[i].evaluate(s, t).g == Approx(1).epsilon(1e-3));
-            }
-    CHECK(g.power == Approx(6 * 3).epsilon(1e-3));  // six unit faces, three channels
-    CHECK(g.rays == 6 * 16 * 16);
-    CHECK(g.iterations > 5);
-    CHECK(g.iterations < ambient_max_iterations);
+    const TestSources held = sources_for(scene, {1, 1, 1}, all);
+    for (int level : {0, 1, 2}) {
+        const AmbientGather g = gather_ambient(scene, octree, held.sources(), 16, level);
+        REQUIRE(g.added.size() == 6);
+        for (size_t i = 0; i < 6; ++i) {
+            CHECK(g.added[i].level() == level);
+            for (double s : {0.1, 0.5, 0.9})
+                for (double t : {0.2, 0.7}) {
+                    CAPTURE(level, scene.surfaces[i].name, s, t);
+                    CHECK(g.added[i].evaluate(s, t).g == Approx(1).epsilon(1e-3));
+                }
+        }
+        CHECK(g.power == Approx(6 * 3).epsilon(1e-3));  // six unit faces, three channels
+        CHECK(g.rays == 6 * (16 << (2 * level)) * 16);  // 4^level x 16 points a face
+        CHECK(g.iterations > 5);
+        CHECK(g.iterations < ambient_max_iterations);
+    }
 }
 
 TEST_CASE("ambient gather: under an unshot square, rho times its point form factor", "[ambient]") {
@@ -125,9 +129,9 @@ TEST_CASE("ambient gather: results do not depend on the thread count", "[ambient
     const AmbientSources sources = held.sources();
     const int before = omp_get_max_threads();
     omp_set_num_threads(1);
-    const AmbientGather one = gather_ambient(scene, octree, sources, 32);
+    const AmbientGather one = gather_ambient(scene, octree, sources, 32, 1);
     omp_set_num_threads(2);
-    const AmbientGather two = gather_ambient(scene, octree, sources, 32);
+    const AmbientGather two = gather_ambient(scene, octree, sources, 32, 1);
     omp_set_num_threads(before);
     CHECK(one.power == two.power);
     CHECK(one.iterations == two.iterations);

@@ -132,6 +132,9 @@ std::vector<OptionSpec> make_option_table() {
                        "by this many cosine-distributed rays, fewer when all of them would pass "
                        "16.8 M (the unshot light lands where it falls, shadows included); 0: a "
                        "constant radiosity per surface"),
+        integer_option("ambient_level", &S::ambient_level, 0, 4, "L",
+                       "the ambient gather's points: the m x m Gauss points of every cell of "
+                       "this level of each surface, and the field it adds at this level"),
         switch_option("limiter", &S::limiter,
                       "where a shot's increment rings above rho_max x the shooter's largest "
                       "coefficient its covering coefficients are clipped to that bound, and "

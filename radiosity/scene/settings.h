@@ -70,6 +70,7 @@ struct SolverSettings {
     UnifySetting unify = UnifySetting::Projection;
     bool ambient = true;     // ambient correction of the unshot power at the end
     int ambient_rays = 256;  //   gathered by this many rays per Gauss point (0: a constant)
+    int ambient_level = 1;   //   at the Gauss points of this level's cells
     bool limiter = true;     // increments and final fields clipped to their physical bounds
     bool hidden = true;      // hidden regions take their visible neighbours' values
     int shooter_level = 3;   // a shooter's unshot field coarsened to at most this level

@@ -8,7 +8,7 @@
 #include "math/check.h"
 #include "math/gauss_legendre.h"
 #include "math/parallel.h"
-#include "radiosity/transfer/weak_transfer.h"
+#include "radiosity/solver/solver.h"
 #include "radiosity/visibility/occlusion.h"
 
 namespace mbr {
@@ -44,11 +44,20 @@ struct GatherHit {
     float u, v;
 };
 
-/// Where the samples of all surfaces live in the flat arrays: surface i's m_i x m_i samples
-/// from first[i], sample (a, b) at first[i] + a m_i + b, at (s_a, t_b).
-std::vector<int> sample_offsets(const std::vector<int>& order) {
+/// The samples along each direction of a surface of order m gathered at `level`: m Gauss
+/// points in each of the 2^level cells.
+int sample_side(int m, int level) {
+    return m << level;
+}
+
+/// Where the samples of all surfaces live in the flat arrays: surface i's side_i^2 samples from
+/// first[i], in l2_projection_of_samples' order.
+std::vector<int> sample_offsets(const std::vector<int>& order, const std::vector<int>& level) {
     std::vector<int> first(order.size() + 1, 0);
-    for (size_t i = 0; i < order.size(); ++i) first[i + 1] = first[i] + order[i] * order[i];
+    for (size_t i = 0; i < order.size(); ++i) {
+        const int side = sample_side(order[i], level[i]);
+        first[i + 1] = first[i] + side * side;
+    }
     return first;
 }
 
@@ -59,17 +68,19 @@ int gather_rays_per_point(int rays, double samples) {
     return std::min(rays, std::max(ambient_min_rays, int(ambient_max_rays / samples)));
 }
 
-double ambient_gather_bytes(const std::vector<int>& order, int rays) {
+double ambient_gather_bytes(const std::vector<int>& order, int level, int rays) {
     double samples = 0;
-    for (int m : order) samples += double(m) * m;
+    for (int m : order) samples += double(sample_side(m, level)) * sample_side(m, level);
     rays = gather_rays_per_point(rays, samples);
     return samples * (double(rays) * sizeof(GatherHit) + 6 * sizeof(Rgb) + sizeof(double) + 1);
 }
 
 AmbientGather gather_ambient(const Scene& scene, const Octree& octree,
-                             const AmbientSources& sources, int rays_asked, std::uint64_t seed) {
+                             const AmbientSources& sources, int rays_asked, int level,
+                             std::uint64_t seed) {
     const int n = static_cast<int>(scene.surfaces.size());
     MBR_CHECK_MSG(rays_asked >= 1, "ambient gather with " << rays_asked << " rays");
+    MBR_CHECK_MSG(level >= 0 && level <= max_ambient_level, "ambient gather at level " << level);
     MBR_CHECK(int(sources.unshot.size()) == n && int(sources.order.size()) == n &&
               int(sources.irradiance.size()) == n);
     // U_j is read once per ray that meets j, by SplineField::evaluate (PolynomialPatches of
@@ -79,7 +90,8 @@ AmbientGather gather_ambient(const Scene& scene, const Octree& octree,
 
     const Box3 box = octree.bounds();
     const double scale = box.empty() ? 1.0 : length(box.extent());
-    const std::vector<int> first = sample_offsets(sources.order);
+    const std::vector<int> levels(n, level);
+    const std::vector<int> first = sample_offsets(sources.order, levels);
     const int n_samples = first[n];
     const int rays = gather_rays_per_point(rays_asked, n_samples);
     auto surface_of = [&](int item) {
@@ -95,12 +107,15 @@ AmbientGather gather_ambient(const Scene& scene, const Octree& octree,
     // runs in a fixed order for any thread count.
     parallel_for(n_samples, [&](int item) {
         const int i = surface_of(item);
-        const int m = sources.order[i], k = item - first[i], a = k / m, b = k % m;
+        const int m = sources.order[i], k = item - first[i], side = sample_side(m, levels[i]);
+        const int cells = 1 << levels[i], S = k / side, T = k % side, a = S % m, b = T % m;
         const Material& material = scene.material_of(i);
         const GaussLegendre rule = gauss_legendre(m);
-        const double s = 0.5 * (rule.x[a] + 1), t = 0.5 * (rule.x[b] + 1);
+        const double s = (S / m + 0.5 * (rule.x[a] + 1)) / cells;
+        const double t = (T / m + 0.5 * (rule.x[b] + 1)) / cells;
         const Surface& surface = scene.surfaces[i].surface;
-        weight[item] = 0.25 * rule.w[a] * rule.w[b] * surface.area_factor(s, t);
+        weight[item] =
+            0.25 * rule.w[a] * rule.w[b] / (double(cells) * cells) * surface.area_factor(s, t);
         rho[item] = material.reflectance.value(s, t);
         if (max_abs(material.reflectance.maximum()) == 0) return;  // reflects nothing
         // A hidden point gathers at its substitute (hidden_regions.h), as every sample does.
@@ -159,8 +174,8 @@ AmbientGather gather_ambient(const Scene& scene, const Octree& octree,
             for (int item = first[i]; item < first[i + 1]; ++item)
                 has_bounce[i] = has_bounce[i] || max_abs(reflected[item]) > 0;
             if (has_bounce[i])
-                bounce[i] = PolynomialPatches(
-                    polynomial_through_gauss_samples(sources.order[i], &reflected[first[i]]));
+                bounce[i] = PolynomialPatches(l2_projection_of_samples(
+                    sources.order[i], levels[i], sources.order[i], &reflected[first[i]]));
         }
         parallel_for(n_samples, [&](int item) {
             if (!gathers[item]) return;
@@ -189,7 +204,8 @@ AmbientGather gather_ambient(const Scene& scene, const Octree& octree,
             any = any || max_abs(samples[item]) > 0;
         }
         if (any)
-            out.added[i] = polynomial_through_gauss_samples(sources.order[i], &samples[first[i]]);
+            out.added[i] = l2_projection_of_samples(sources.order[i], levels[i], sources.order[i],
+                                                    &samples[first[i]]);
     }
     return out;
 }

@@ -1,9 +1,10 @@
 // radiosity/solver/ambient_gather.h - the ambient correction gathered (beyond the paper): at the
 // end of a solve, the power still unshot, U, and everything it becomes after further bounces are
-// gathered by rays at the m x m Gauss-Legendre points of every surface, so that the light the
-// progressive loop did not send lands where it falls, shadows and distances included, instead
-// of as a constant per surface (Cohen et al. 1988's ambient term). What each surface gains is
-// the level-0 field through its gathered samples (docs/method.md, "The ambient correction").
+// gathered by rays at the m x m Gauss-Legendre points of every cell of one level of every
+// surface, so that the light the progressive loop did not send lands where it falls, shadows and
+// distances included, instead of as a constant per surface (Cohen et al. 1988's ambient term).
+// What each surface gains is the L2 projection of its gathered samples at that level
+// (docs/method.md, "Ambient correction, gathered").
 #pragma once
 
 #include <cstdint>
@@ -51,22 +52,27 @@ constexpr int ambient_min_rays = 16;
 /// ambient_max_rays.
 int gather_rays_per_point(int rays, double samples);
 
-/// The memory the gather holds: per sample (m_i^2 of each surface of order m_i) its kept hits
+/// The memory the gather holds: per sample (4^level m_i^2 of each surface of order m_i) its kept hits
 /// (an int and two floats a ray) and six colours and a weight.
-double ambient_gather_bytes(const std::vector<int>& order, int rays);
+double ambient_gather_bytes(const std::vector<int>& order, int level, int rays);
 
-/// The gather. At each of the m x m Gauss-Legendre points p of every surface with a reflectance
-/// (a hidden point at its substitute), gather_rays_per_point(rays, points) cosine-distributed
-/// directions (a Hammersley set
+/// The finest level the gather takes.
+constexpr int max_ambient_level = 4;
+
+/// The gather. At each of the m x m Gauss-Legendre points p of every level-`level` cell of every
+/// surface with a reflectance (a hidden point at its substitute),
+/// gather_rays_per_point(rays, points) cosine-distributed directions (a Hammersley set
 /// shifted per point: stratified, reproducible, independent of the thread count) find the
 /// first surface in front; the ray's hit (j, u, v) is kept, a back face or nothing counts 0.
 /// The gathered irradiance is the mean over the rays of what leaves the hit (eq. (1) with the
 /// cos / pi weights of the directions):
-///   H(p) = mean [U_j(u, v) + R_j(u, v)],   R_i = the level-0 field through rho(p) H(p),
+///   H(p) = mean [U_j(u, v) + R_j(u, v)],
+///   R_i = l2_projection_of_samples of rho(p) H(p) over i's points (solver.h),
 /// solved by Jacobi iteration from R = 0 (U's first bounce, then each further bounce), until
 /// the added power changes by less than ambient_iteration_tolerance of itself. The samples
-/// added are rho H (H itself for an irradiance field). `octree` is build_octree(scene).
+/// projected are rho H (H itself for an irradiance field). `octree` is build_octree(scene).
 AmbientGather gather_ambient(const Scene& scene, const Octree& octree,
-                             const AmbientSources& sources, int rays, std::uint64_t seed = 1);
+                             const AmbientSources& sources, int rays, int level = 0,
+                             std::uint64_t seed = 1);
 
 }  // namespace mbr

@@ -142,7 +142,8 @@ CostEstimate scene_cost(const Scene& scene, const SolverOptions& options, int th
                   pairs * 96.0;
     // The ambient gather's rays at the end (ambient_gather.h).
     const double gather = options.ambient && options.ambient_rays > 0
-                              ? ambient_gather_bytes(orders, options.ambient_rays)
+                              ? ambient_gather_bytes(orders, options.ambient_level,
+                                                     options.ambient_rays)
                               : 0.0;
     CostEstimate c;
     c.bytes = program_bytes + fields + hidden + transfers + caches + polygons + textures +

@@ -200,6 +200,8 @@ SolverOptions solver_options(const SolverSettings& s) {
     o.tolerance = s.tolerance;
     o.ambient = s.ambient;
     o.ambient_rays = s.ambient_rays;
+    o.ambient_level = s.ambient_level;
+    static_assert(max_ambient_level == 4, "the option table's range of ambient_level");
     o.limiter = s.limiter;
     o.irradiance_fields = s.texture_field == TextureFieldSetting::Irradiance;
     o.hidden_regions = s.hidden;
@@ -207,12 +209,13 @@ SolverOptions solver_options(const SolverSettings& s) {
     return o;
 }
 
-SplineField l2_projection(const std::function<Rgb(double, double)>& f, int m, int level) {
+SplineField l2_projection_of_samples(int m, int level, int points, const Rgb* samples) {
     // L2([0,1]^2) projection onto the touching basis of the level: (G x G) c = b with
-    // b_kl = int int f N_k N_l by 8 x 8 Gauss points per cell (textures are only piecewise
-    // smooth) and the 1D Gram matrix G, exact by m-point Gauss per cell.
+    // b_kl = int int f N_k N_l by the samples' Gauss rule and the 1D Gram matrix G, exact by
+    // m-point Gauss per cell.
     const int first = first_touching_index(m), n = touching_count(m, level), cells = 1 << level;
-    const GaussLegendre rule_g = gauss_legendre(m), rule_b = gauss_legendre(8);
+    const GaussLegendre rule_g = gauss_legendre(m), rule_b = gauss_legendre(points);
+    const int side = cells * points;  // samples along each direction
     std::vector<double> G(size_t(n) * n, 0.0);
     double v[16];
     for (int cell = 0; cell < cells; ++cell)
@@ -239,7 +242,8 @@ SplineField l2_projection(const std::function<Rgb(double, double)>& f, int m, in
                     const double t = (cj + 0.5 * (rule_b.x[qb] + 1)) / cells;
                     const int fl = bspline_values(m, std::ldexp(t, level), vt);
                     const double w = 0.25 * rule_b.w[qa] * rule_b.w[qb] / (double(cells) * cells);
-                    const Rgb value = f(s, t);
+                    const Rgb value =
+                        samples[size_t(ci * points + qa) * side + size_t(cj * points + qb)];
                     for (int c = 0; c < 3; ++c) {
                         const double e = w * value[c];
                         for (int a = 0; a < m; ++a)
@@ -268,6 +272,19 @@ SplineField l2_projection(const std::function<Rgb(double, double)>& f, int m, in
         }
     }
     return field;
+}
+
+SplineField l2_projection(const std::function<Rgb(double, double)>& f, int m, int level) {
+    // f at 8 x 8 Gauss points per cell (textures are only piecewise smooth).
+    constexpr int points = 8;
+    const int cells = 1 << level, side = cells * points;
+    const GaussLegendre rule = gauss_legendre(points);
+    std::vector<Rgb> samples(size_t(side) * side);
+    for (int i = 0; i < side; ++i)
+        for (int j = 0; j < side; ++j)
+            samples[size_t(i) * side + j] = f((i / points + 0.5 * (rule.x[i % points] + 1)) / cells,
+                                              (j / points + 0.5 * (rule.x[j % points] + 1)) / cells);
+    return l2_projection_of_samples(m, level, points, samples.data());
 }
 
 SplineField project_emission(const Texture& emission, int m, int level) {
@@ -781,7 +798,7 @@ Solution ProgressiveSolver::finish() {
         const AmbientSources sources{solution_.unshot, order_, irradiance, hidden_};
         const double gather_start = now();
         const AmbientGather gather =
-            gather_ambient(scene_, octree_, sources, options_.ambient_rays);
+            gather_ambient(scene_, octree_, sources, options_.ambient_rays, options_.ambient_level);
         st.ambient_seconds = now() - gather_start;
         for (size_t i = 0; i < gather.added.size(); ++i)
             if (!gather.added[i].empty()) out.radiosity[i].add(gather.added[i]);

@@ -73,6 +73,7 @@ struct SolverOptions {
     int ambient_rays = 256;         //   gathered by this many rays at each surface's m x m Gauss
                                     //   points (ambient_gather.h, gather_rays_per_point); 0: the
                                     //   constant per surface
+    int ambient_level = 1;          //   at the Gauss points of this level's cells
 };
 
 /// The scene's `set` statements as solver options (shadows: the scene's method and rays).
@@ -257,8 +258,15 @@ Solution solve(const Scene& scene, const Octree& octree, const SolverOptions& op
 /// the L2 projection at `level` (Gauss-Legendre quadrature of the texture against the basis,
 /// then the Gram solve of math/wavelet.h's kind).
 SplineField project_emission(const Texture& emission, int m, int level);
-/// The L2([0,1]^2) projection of f onto the order-m basis of `level` (the same rule).
+/// The L2([0,1]^2) projection of f onto the order-m basis of `level` (the same rule, f at 8 x 8
+/// Gauss-Legendre points per cell).
 SplineField l2_projection(const std::function<Rgb(double, double)>& f, int m, int level);
+/// The same projection from samples at the `points`-point Gauss-Legendre nodes of every
+/// level-`level` cell: a grid of side = 2^level x points values, samples[S * side + T] at
+/// ((S / points + x_(S % points)) / 2^level, (T / points + x_(T % points)) / 2^level), x the
+/// nodes on [0,1]. With points >= m the Gram matrix is exact; at level 0 with points = m it is
+/// the tensor polynomial through the samples.
+SplineField l2_projection_of_samples(int m, int level, int points, const Rgb* samples);
 
 }  // namespace mbr
 

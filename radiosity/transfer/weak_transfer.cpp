@@ -74,7 +74,11 @@ bool root_samples_represent(const Surface& shooter, const Surface& receiver) {
     return gap2 >= 0.25 * diagonal * diagonal;
 }
 
-SplineField polynomial_through_gauss_samples(int m, const Rgb* f) {
+SplineField project_root_polynomial(ReceiverState& state) {
+    const int m = state.options.m;
+    const Forest::Node& root = state.forest.node(state.forest.domain_root());
+    MBR_CHECK_MSG(root.is_leaf() && root.samples >= 0, "a weak transfer needs the root's samples");
+    const Rgb* f = &state.samples[size_t(root.samples) * m * m];  // f[a * m + b] at (s_a, t_b)
     const std::vector<double> inv = inverse_collocation(m);
     // C = V^-1 F V^-T: first along t (b -> l), then along s (a -> k).
     std::vector<Rgb> g(size_t(m) * m);  // g[a * m + l]
@@ -92,15 +96,6 @@ SplineField polynomial_through_gauss_samples(int m, const Rgb* f) {
             for (int a = 0; a < m; ++a) c += inv[size_t(k) * m + a] * g[size_t(a) * m + l];
             field.set_coefficient(first + k, first + l, c);
         }
-    return field;
-}
-
-SplineField project_root_polynomial(ReceiverState& state) {
-    const int m = state.options.m;
-    const Forest::Node& root = state.forest.node(state.forest.domain_root());
-    MBR_CHECK_MSG(root.is_leaf() && root.samples >= 0, "a weak transfer needs the root's samples");
-    SplineField field =
-        polynomial_through_gauss_samples(m, &state.samples[size_t(root.samples) * m * m]);
     state.stats.n_projections += m * m;
     state.stats.level = 0;
     return field;

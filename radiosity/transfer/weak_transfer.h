@@ -31,11 +31,6 @@ bool root_samples_represent(const Surface& shooter, const Surface& receiver);
 /// the m x m collocation matrix N_m(x_a - k) on each side).
 SplineField project_root_polynomial(ReceiverState& state);
 
-/// The level-0 field of order m through m x m values at the m-point Gauss-Legendre nodes of
-/// [0,1]^2 (f[a * m + b] at (s_a, t_b)): the tensor polynomial through them in the level-0
-/// B-spline basis (project_root_polynomial's projection, for any samples).
-SplineField polynomial_through_gauss_samples(int m, const Rgb* f);
-
 /// Stage 7's masking for a weak transfer under the paper's shadows: every coefficient of the
 /// level-0 field times its fulcrum's fraction (28), at fraction_point (the domain's corners).
 void mask_root_coefficients(SplineField& field, ReceiverState& state, IncrementSampler& sampler);
