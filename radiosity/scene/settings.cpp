@@ -128,8 +128,9 @@ std::vector<OptionSpec> make_option_table() {
                       "at the end, the power still unshot is sent on through the measured "
                       "coupling of the surfaces (an ambient term)"),
         integer_option("ambient_rays", &S::ambient_rays, 0, 4096, "R",
-                       "the ambient correction is gathered at each surface's m x m Gauss points "
-                       "by this many cosine-distributed rays, fewer when all of them would pass "
+                       "the ambient correction is gathered at each surface's Gauss points (see "
+                       "ambient_level) by this many cosine-distributed rays per point, fewer "
+                       "when all of them would pass "
                        "16.8 M (the unshot light lands where it falls, shadows included); 0: a "
                        "constant radiosity per surface"),
         integer_option("ambient_level", &S::ambient_level, 0, 4, "L",

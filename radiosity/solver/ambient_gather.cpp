@@ -52,10 +52,10 @@ int sample_side(int m, int level) {
 
 /// Where the samples of all surfaces live in the flat arrays: surface i's side_i^2 samples from
 /// first[i], in l2_projection_of_samples' order.
-std::vector<int> sample_offsets(const std::vector<int>& order, const std::vector<int>& level) {
+std::vector<int> sample_offsets(const std::vector<int>& order, int level) {
     std::vector<int> first(order.size() + 1, 0);
     for (size_t i = 0; i < order.size(); ++i) {
-        const int side = sample_side(order[i], level[i]);
+        const int side = sample_side(order[i], level);
         first[i + 1] = first[i] + side * side;
     }
     return first;
@@ -90,8 +90,7 @@ AmbientGather gather_ambient(const Scene& scene, const Octree& octree,
 
     const Box3 box = octree.bounds();
     const double scale = box.empty() ? 1.0 : length(box.extent());
-    const std::vector<int> levels(n, level);
-    const std::vector<int> first = sample_offsets(sources.order, levels);
+    const std::vector<int> first = sample_offsets(sources.order, level);
     const int n_samples = first[n];
     const int rays = gather_rays_per_point(rays_asked, n_samples);
     auto surface_of = [&](int item) {
@@ -107,12 +106,12 @@ AmbientGather gather_ambient(const Scene& scene, const Octree& octree,
     // runs in a fixed order for any thread count.
     parallel_for(n_samples, [&](int item) {
         const int i = surface_of(item);
-        const int m = sources.order[i], k = item - first[i], side = sample_side(m, levels[i]);
-        const int cells = 1 << levels[i], S = k / side, T = k % side, a = S % m, b = T % m;
+        const int m = sources.order[i], k = item - first[i], side = sample_side(m, level);
+        const int cells = 1 << level, S = k / side, T = k % side, a = S % m, b = T % m;
         const Material& material = scene.material_of(i);
         const GaussLegendre rule = gauss_legendre(m);
-        const double s = (S / m + 0.5 * (rule.x[a] + 1)) / cells;
-        const double t = (T / m + 0.5 * (rule.x[b] + 1)) / cells;
+        const double s = projection_sample_coordinate(rule, S, level);
+        const double t = projection_sample_coordinate(rule, T, level);
         const Surface& surface = scene.surfaces[i].surface;
         weight[item] =
             0.25 * rule.w[a] * rule.w[b] / (double(cells) * cells) * surface.area_factor(s, t);
@@ -123,11 +122,9 @@ AmbientGather gather_ambient(const Scene& scene, const Octree& octree,
             i < int(sources.hidden.size()) ? sources.hidden[i].substitute(s, t) : Vec2{s, t};
         const SurfacePoint p = surface.evaluate(q.x, q.y);
         if (!(p.area_factor > 0)) return;  // a degenerate point: nothing gathered
-        const Vec3 nz = p.normal;
-        const Vec3 helper = std::fabs(nz.x) < 0.9 ? Vec3{1, 0, 0} : Vec3{0, 1, 0};
-        const Vec3 nx = normalize(cross(helper, nz)), ny = cross(nz, nx);
+        const CosineFrame frame(p.normal);
         // DESIGN: as find_hidden's rays, from the true surface 1e-7 of the scene in front.
-        const Vec3 origin = p.position + (1e-7 * scale) * nz;
+        const Vec3 origin = p.position + (1e-7 * scale) * p.normal;
         const std::uint64_t key =
             hash_seed(seed ^ 0x616d6269656e74ULL, std::uint64_t(i), std::uint64_t(k));
         const double shift_1 = uniform01(key, 0), shift_2 = uniform01(key, 1);
@@ -136,12 +133,8 @@ AmbientGather gather_ambient(const Scene& scene, const Octree& octree,
         for (int r = 0; r < rays; ++r) {
             // Hammersley point r of `rays`, shifted (Cranley and Patterson 1976), lifted to the
             // cosine-distributed hemisphere (density cos theta / pi).
-            const double u_1 = wrap01((r + 0.5) / rays + shift_1);
-            const double u_2 = wrap01(radical_inverse_2(std::uint32_t(r)) + shift_2);
-            const double phi = 2 * Pi * u_1, sin_theta = std::sqrt(u_2);
-            const double cos_theta = std::sqrt(std::max(0.0, 1 - u_2));
-            const Vec3 dir = (sin_theta * std::cos(phi)) * nx + (sin_theta * std::sin(phi)) * ny +
-                             cos_theta * nz;
+            const Vec3 dir = frame.direction(wrap01((r + 0.5) / rays + shift_1),
+                                             wrap01(radical_inverse_2(std::uint32_t(r)) + shift_2));
             const std::optional<Hit> hit =
                 octree.closest_hit(Ray{origin, dir, 0, HUGE_VAL}, RayFilter{-1, -1, true});
             if (!hit || dot(octree.polygons()[hit->polygon].normal(), dir) > 0) continue;
@@ -175,7 +168,7 @@ AmbientGather gather_ambient(const Scene& scene, const Octree& octree,
                 has_bounce[i] = has_bounce[i] || max_abs(reflected[item]) > 0;
             if (has_bounce[i])
                 bounce[i] = PolynomialPatches(l2_projection_of_samples(
-                    sources.order[i], levels[i], sources.order[i], &reflected[first[i]]));
+                    sources.order[i], level, sources.order[i], &reflected[first[i]]));
         }
         parallel_for(n_samples, [&](int item) {
             if (!gathers[item]) return;
@@ -204,7 +197,7 @@ AmbientGather gather_ambient(const Scene& scene, const Octree& octree,
             any = any || max_abs(samples[item]) > 0;
         }
         if (any)
-            out.added[i] = l2_projection_of_samples(sources.order[i], levels[i], sources.order[i],
+            out.added[i] = l2_projection_of_samples(sources.order[i], level, sources.order[i],
                                                     &samples[first[i]]);
     }
     return out;

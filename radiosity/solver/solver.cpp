@@ -235,11 +235,11 @@ SplineField l2_projection_of_samples(int m, int level, int points, const Rgb* sa
     double vs[16], vt[16];
     for (int ci = 0; ci < cells; ++ci)
         for (int qa = 0; qa < rule_b.n(); ++qa) {
-            const double s = (ci + 0.5 * (rule_b.x[qa] + 1)) / cells;
+            const double s = projection_sample_coordinate(rule_b, ci * points + qa, level);
             const int fk = bspline_values(m, std::ldexp(s, level), vs);
             for (int cj = 0; cj < cells; ++cj)
                 for (int qb = 0; qb < rule_b.n(); ++qb) {
-                    const double t = (cj + 0.5 * (rule_b.x[qb] + 1)) / cells;
+                    const double t = projection_sample_coordinate(rule_b, cj * points + qb, level);
                     const int fl = bspline_values(m, std::ldexp(t, level), vt);
                     const double w = 0.25 * rule_b.w[qa] * rule_b.w[qb] / (double(cells) * cells);
                     const Rgb value =
@@ -282,9 +282,14 @@ SplineField l2_projection(const std::function<Rgb(double, double)>& f, int m, in
     std::vector<Rgb> samples(size_t(side) * side);
     for (int i = 0; i < side; ++i)
         for (int j = 0; j < side; ++j)
-            samples[size_t(i) * side + j] = f((i / points + 0.5 * (rule.x[i % points] + 1)) / cells,
-                                              (j / points + 0.5 * (rule.x[j % points] + 1)) / cells);
+            samples[size_t(i) * side + j] = f(projection_sample_coordinate(rule, i, level),
+                                              projection_sample_coordinate(rule, j, level));
     return l2_projection_of_samples(m, level, points, samples.data());
+}
+
+double projection_sample_coordinate(const GaussLegendre& rule, int index, int level) {
+    const int points = rule.n();
+    return (index / points + 0.5 * (rule.x[index % points] + 1)) / (1 << level);
 }
 
 SplineField project_emission(const Texture& emission, int m, int level) {

@@ -35,6 +35,8 @@
 
 namespace mbr {
 
+struct GaussLegendre;
+
 /// Options of the progressive loop and of its transfers.
 struct SolverOptions {
     ReceiverOptions receiver;   // every transfer's options (order, depths, shadows, ...); its
@@ -70,9 +72,9 @@ struct SolverOptions {
                                     //   over all its shots) and added as a constant radiosity per
                                     //   surface (Cohen et al. 1988's ambient term, with measured
                                     //   instead of area-weighted coupling)
-    int ambient_rays = 256;         //   gathered by this many rays at each surface's m x m Gauss
-                                    //   points (ambient_gather.h, gather_rays_per_point); 0: the
-                                    //   constant per surface
+    int ambient_rays = 256;         //   gathered by this many rays per Gauss point of each
+                                    //   surface (ambient_gather.h, gather_rays_per_point); 0:
+                                    //   the constant per surface
     int ambient_level = 1;          //   at the Gauss points of this level's cells
 };
 
@@ -267,6 +269,9 @@ SplineField l2_projection(const std::function<Rgb(double, double)>& f, int m, in
 /// nodes on [0,1]. With points >= m the Gram matrix is exact; at level 0 with points = m it is
 /// the tensor polynomial through the samples.
 SplineField l2_projection_of_samples(int m, int level, int points, const Rgb* samples);
+/// The coordinate on [0,1] of sample `index` along one direction of that grid: (index / points
+/// + x_(index % points)) / 2^level, with the nodes of `rule` (points = rule.n()).
+double projection_sample_coordinate(const GaussLegendre& rule, int index, int level);
 
 }  // namespace mbr
 

@@ -80,10 +80,7 @@ HiddenMask find_hidden(const Surface& surface, int surface_id, const Octree& oct
         const int i = k % n, j = k / n;
         const SurfacePoint p = surface.evaluate((i + 0.5) / n, (j + 0.5) / n);
         if (!(p.area_factor > 0)) return;  // a degenerate point (a pole): leave it visible
-        // An orthonormal frame around the normal for cosine-distributed directions.
-        const Vec3 nz = p.normal;
-        const Vec3 helper = std::fabs(nz.x) < 0.9 ? Vec3{1, 0, 0} : Vec3{0, 1, 0};
-        const Vec3 nx = normalize(cross(helper, nz)), ny = cross(nz, nx);
+        const CosineFrame frame(p.normal);
         const std::uint64_t key =
             hash_seed(0x6869646465ULL, std::uint64_t(surface_id), std::uint64_t(k));
         // DESIGN: the ray starts 1e-7 of the scene's size in front of the surface, so it does not
@@ -91,13 +88,10 @@ HiddenMask find_hidden(const Surface& surface, int surface_id, const Octree& oct
         // of a curved one near it (its own, a neighbour's across a shared edge) do not count
         // (Polygon::hit_counts): from inside a sphere of 16 x 16 facets, its own facets' backs
         // hid 94 % of its texels (3844 of 4096), which then took the values of the few left.
-        const Vec3 origin = p.position + (1e-7 * scale) * nz;
+        const Vec3 origin = p.position + (1e-7 * scale) * p.normal;
         int back = 0, cast = 0;
         for (int r = 0; r < hidden_rays; ++r) {
-            const double a = uniform01(key, 2 * r), b = uniform01(key, 2 * r + 1);
-            const double phi = 2 * Pi * a, sin_theta = std::sqrt(b), cos_theta = std::sqrt(1 - b);
-            const Vec3 dir = (sin_theta * std::cos(phi)) * nx + (sin_theta * std::sin(phi)) * ny +
-                             cos_theta * nz;
+            const Vec3 dir = frame.direction(uniform01(key, 2 * r), uniform01(key, 2 * r + 1));
             ++cast;
             const std::optional<Hit> hit =
                 octree.closest_hit(Ray{origin, dir, 0, HUGE_VAL}, RayFilter{-1, -1, true});

@@ -29,6 +29,18 @@ double uniform01(std::uint64_t key, std::uint64_t index) {
     return double(hash_seed(key, index) >> 11) * 0x1.0p-53;
 }
 
+CosineFrame::CosineFrame(Vec3 normal) : nz(normal) {
+    const Vec3 helper = std::fabs(nz.x) < 0.9 ? Vec3{1, 0, 0} : Vec3{0, 1, 0};
+    nx = normalize(cross(helper, nz));
+    ny = cross(nz, nx);
+}
+
+Vec3 CosineFrame::direction(double a, double b) const {
+    const double phi = 2 * Pi * a, sin_theta = std::sqrt(b);
+    const double cos_theta = std::sqrt(std::max(0.0, 1 - b));
+    return (sin_theta * std::cos(phi)) * nx + (sin_theta * std::sin(phi)) * ny + cos_theta * nz;
+}
+
 // ---- Occluders of a pair -----------------------------------------------------------------
 
 std::vector<Vec3> hull_points(const Surface& surface) {

@@ -74,4 +74,13 @@ std::uint64_t hash_seed(std::uint64_t a, std::uint64_t b, std::uint64_t c = 0, s
 /// A uniform double in [0, 1) from a counter (the hash of `key` and `index`).
 double uniform01(std::uint64_t key, std::uint64_t index);
 
+/// An orthonormal frame around a unit normal, for directions distributed by cos(theta) / pi
+/// over the hemisphere in front (the rays of find_hidden and of the ambient gather).
+struct CosineFrame {
+    Vec3 nx, ny, nz;
+    explicit CosineFrame(Vec3 normal);
+    /// The direction of the unit-square point (a, b): phi = 2 pi a, sin^2(theta) = b.
+    Vec3 direction(double a, double b) const;
+};
+
 }  // namespace mbr
