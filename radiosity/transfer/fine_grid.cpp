@@ -110,18 +110,27 @@ SplineField project_fine_grid(ReceiverState& state, const DualTable& dn) {
         c0 = std::max(lo, static_cast<int>(std::floor(centre - r)) - 1);
         c1 = std::min(hi - 1, static_cast<int>(std::ceil(centre + r)));
     };
+    // The weights (w_a / 2) DN(o + x_a) of the cell at offset o = i - k from coefficient k, laid
+    // out as the grid's nodes are, so that a window of cells is one contiguous run of both.
+    std::vector<double> weights(size_t(tables.n_offsets) * m);
+    for (int o = 0; o < tables.n_offsets; ++o)
+        for (int a = 0; a < m; ++a)
+            weights[size_t(o) * m + a] = 0.5 * rule.w[a] * tables.dn(tables.first_offset + o, a);
     // One of the one-dimensional sums: sum over the cells and nodes of `row` (stride 1) of
     // (w_a / 2) DN(i + x_a - k) row[i m + a], for the coefficient index k.
     auto sum_along = [&](const Rgb* row, int k) {
         int c0, c1;
         window(k, c0, c1);
-        Rgb sum;
-        for (int i = c0; i <= c1; ++i)
-            for (int a = 0; a < m; ++a) {
-                const double w = 0.5 * rule.w[a] * tables.dn(i - k, a);
-                if (w != 0) sum += w * row[size_t(i - lo) * m + a];
-            }
-        return sum;
+        MBR_CHECK(c0 - k >= tables.first_offset && c1 - k < tables.first_offset + tables.n_offsets);
+        const double* w = &weights[size_t(c0 - k - tables.first_offset) * m];
+        const Rgb* f = &row[size_t(c0 - lo) * m];
+        double r = 0, g = 0, b = 0;  // in the order of the cells and nodes
+        for (int q = 0, n = (c1 - c0 + 1) * m; q < n; ++q) {
+            r += w[q] * f[q].r;
+            g += w[q] * f[q].g;
+            b += w[q] * f[q].b;
+        }
+        return Rgb{r, g, b};
     };
     std::vector<Rgb> g(size_t(n_coef) * n_nodes);  // g[k * n_nodes + row]: summed along s
     parallel_for(n_nodes, [&](int row) {
