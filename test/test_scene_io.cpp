@@ -472,7 +472,7 @@ TEST_CASE("scene_io: settings and camera are checked", "[scene_io][errors]") {
     check_error(white + square + "set extrapolation cubic\n", 3, "neither 'linear' nor 'higher'");
     check_error(white + square + "set self_transfer yes\n", 3, "neither 'true' nor 'false'");
     check_error(white + square + "set contact_oracle mean\n", 3,
-                "contact_oracle 'mean' is neither 'interpolation' nor 'means'");
+                "contact_oracle 'mean' is not 'hybrid', 'interpolation' or 'means'");
     check_error(white + square + "set min_depth 5\nset max_depth 3\n", 4,
                 "min_depth 5 exceeds max_depth 3");
     check_error(white + square + "camera eye 0 0 1 look_at 0 0 1\n", 3, "eye and look_at coincide");
@@ -537,12 +537,14 @@ TEST_CASE("scene_io: every statement of the format", "[scene_io]") {
     CHECK(o.convergence == 0.01);
     CHECK(o.self_transfer);
     CHECK(o.tessellation == 8);
-    CHECK(o.contact_oracle == ContactOracleSetting::Interpolation);
+    CHECK(o.contact_oracle == OracleSetting::Interpolation);
     CHECK(solver_options(o).receiver.contact_oracle_test == OracleTest::Interpolation);
     // Defaults when nothing is set.
     Scene d = parse_text(white + square);
     CHECK(d.settings.order == 4);
-    CHECK(d.settings.contact_oracle == ContactOracleSetting::Means);
+    CHECK(d.settings.oracle == OracleSetting::Hybrid);
+    CHECK(d.settings.contact_oracle == OracleSetting::Means);
+    CHECK(solver_options(d.settings).receiver.oracle_test == OracleTest::Hybrid);
     CHECK(solver_options(d.settings).receiver.contact_oracle_test == OracleTest::Means);
     CHECK(d.settings.extrapolation == ExtrapolationSetting::Linear);
     CHECK(!d.has_camera);

@@ -249,11 +249,13 @@ int run(Args& args) {
         return 0;
     }
     const SolverOptions& o = run.options;
+    const OracleTest contact = o.receiver.contact_oracle_test;
     std::cout << "closed cube of unit side, reflectance " << rho << "; order " << o.receiver.m
               << ", depths " << o.receiver.min_depth << ".." << o.receiver.max_depth
               << ", tolerance " << o.tolerance << ", contact oracle "
-              << (o.receiver.contact_oracle_test == OracleTest::Interpolation ? "interpolation"
-                                                                              : "means")
+              << (contact == OracleTest::Interpolation ? "interpolation"
+                  : contact == OracleTest::Hybrid      ? "hybrid"
+                                                       : "means")
               << ", convergence " << o.convergence << ", clamp_values "
               << (o.receiver.clamp_values ? "on" : "off") << ", at most " << o.max_shots
               << " shots; grid " << n << " x " << n << " cell centres per face\n"

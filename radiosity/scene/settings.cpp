@@ -92,6 +92,12 @@ std::vector<OptionSpec> make_option_table() {
                        "= d gives uniform leaves 2^-d wide (Tables 1, 2)"),
         real_option("oracle_tolerance", &S::oracle_tolerance, 0, 1, true, false, "x",
                     "relative agreement of the oracle's two Gauss-Legendre rules"),
+        choice_option("oracle", &S::oracle, {"hybrid", "interpolation", "means"},
+                      "the oracle's test of a cell: the paper's two means where the relative "
+                      "tolerance governs and, where the absolute one does, the polynomial "
+                      "through the m^2 samples predicting the others within two absolute "
+                      "tolerances (hybrid: a dim shot's shadows stay sharp; docs/method.md), "
+                      "that fit everywhere, or the paper's two means everywhere"),
         real_option("truncation_eps", &S::truncation_eps, 0, 1, true, true, "eps",
                     "relative cut-off of the dual basis (the rhombus of Figure 3)"),
         real_option("rhombus_radius", &S::rhombus_radius, 0, 1000, false, false, "r",
@@ -157,11 +163,11 @@ std::vector<OptionSpec> make_option_table() {
                     "absolute tolerances keeps the root as its only cell and takes the "
                     "polynomial through them (no edgefill, no extrapolated ring); 0: the full "
                     "pipeline for every transfer"),
-        choice_option("contact_oracle", &S::contact_oracle, {"interpolation", "means"},
-                      "the oracle's test in receiver cells that touch a planar shooter: the "
-                      "polynomial through the m^2 samples predicting the others (follows B at "
-                      "shared edges and corners, at more cost; docs/method.md), or the paper's "
-                      "two means"),
+        choice_option("contact_oracle", &S::contact_oracle, {"hybrid", "interpolation", "means"},
+                      "the oracle's test in receiver cells that touch a planar shooter (see "
+                      "oracle): interpolation follows B at shared edges and corners, at more "
+                      "cost; the paper's means cost least and do best on the Cornell box "
+                      "(docs/method.md)"),
         choice_option("fraction_rays", &S::fraction_rays, {"kernel", "area"},
                       "paper shadows: how a fraction (28) counts its rays to a shooter patch: "
                       "each weighted by the shooter's radiosity times the kernel (3) at its end "

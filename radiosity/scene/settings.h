@@ -32,8 +32,10 @@ enum class UnifySetting {
     Projection,  // "projection": every finest-scale coefficient projected on the fine grid
     Paper        // "paper": (17) from the selected fulcrums
 };
-/// The oracle's test in receiver cells that touch a planar shooter.
-enum class ContactOracleSetting {
+/// The oracle's test (OracleTest), everywhere and in receiver cells that touch a planar shooter.
+enum class OracleSetting {
+    Hybrid,         // "hybrid": the means where the relative tolerance governs, the fit where
+                    //   the absolute tolerance does
     Interpolation,  // "interpolation": the polynomial through the m^2 samples predicts the others
     Means           // "means": the paper's two means
 };
@@ -76,7 +78,8 @@ struct SolverSettings {
     int shooter_level = 3;   // a shooter's unshot field coarsened to at most this level
     int contact_depth = 2;   // receiver cells touching a planar shooter split to at
                              //   least this level (0: off)
-    ContactOracleSetting contact_oracle = ContactOracleSetting::Means;
+    OracleSetting oracle = OracleSetting::Hybrid;
+    OracleSetting contact_oracle = OracleSetting::Means;
     double weak_transfer = 0.3;  // a transfer whose root samples are below this many
                                  //   tolerances takes the level-0 field through them (0: off)
     TextureFieldSetting texture_field = TextureFieldSetting::Irradiance;
