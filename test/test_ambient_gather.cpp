@@ -187,3 +187,94 @@ TEST_CASE("ambient gather: the Cornell box stopped early lands nearer its conver
     CHECK(gathered.stats.ambient_rays > 0);
     CHECK(e_gathered < 0.5 * e_constant);
 }
+
+TEST_CASE("ambient gather: the final gather level follows the surface's size", "[ambient]") {
+    // Cells no wider than 1/16 of the scene's diagonal: a 10 x 10 square (diagonal 14.1) in a
+    // scene of diagonal 17.3 needs 14.1 / 2^l <= 1.08, level 4; a unit square stays at level 1;
+    // nothing goes past max_ambient_level however large.
+    const Scene scene = scene_from(
+        "material grey reflectance 0.5 0.5 0.5\n"
+        "rectangle big   grey  0 0 0   0 0 10   10 0 0\n"
+        "rectangle small grey  0 1 0   0 0 1    1 0 0\n"
+        "rectangle huge  grey  0 2 0   0 0 1000 1000 0 0\n");
+    const double diagonal = std::sqrt(300.0);
+    CHECK(final_gather_level(scene.surfaces[scene.find_surface("big")].surface, diagonal, 1) == 4);
+    CHECK(final_gather_level(scene.surfaces[scene.find_surface("small")].surface, diagonal, 1) ==
+          1);
+    CHECK(final_gather_level(scene.surfaces[scene.find_surface("huge")].surface, diagonal, 1) ==
+          max_ambient_level);
+    CHECK(final_gather_level(scene.surfaces[scene.find_surface("small")].surface, diagonal, 3) ==
+          3);  // never coarser than the gather's own level
+}
+
+TEST_CASE("ambient gather: the final gather keeps a closed box exact at its finer level",
+          "[ambient]") {
+    // Unit cube (diagonal 1.73, cells of 0.108): each face (diagonal 1.41) gathers once more at
+    // level 4, one bounce from U + R with R converged: rho (U + R) = 0.5 (1 + 1) = 1 again.
+    const Scene scene = scene_from(
+        "material white reflectance 0.5 0.5 0.5\n"
+        "box cube white  0 0 0  1 1 1  inward\n");
+    const Octree octree = build_octree(scene);
+    std::vector<std::string> all;
+    for (const SceneSurface& s : scene.surfaces) all.push_back(s.name);
+    const TestSources held = sources_for(scene, {1, 1, 1}, all);
+    const AmbientGather plain = gather_ambient(scene, octree, held.sources(), 64, 1);
+    const AmbientGather g = gather_ambient(scene, octree, held.sources(), 64, 1, 1, 0.5);
+    REQUIRE(g.added.size() == 6);
+    for (size_t i = 0; i < 6; ++i) {
+        CHECK(g.added[i].level() == 4);
+        for (double s : {0.1, 0.5, 0.9})
+            for (double t : {0.2, 0.7}) {
+                CAPTURE(scene.surfaces[i].name, s, t);
+                CHECK(g.added[i].evaluate(s, t).g == Approx(1).epsilon(1e-3));
+            }
+    }
+    CHECK(g.power == Approx(6 * 3).epsilon(1e-3));
+    // The first gather's rays (16 points a level-1 cell, 64 rays) and the final gather's (16
+    // points a level-4 cell, a quarter of the rays).
+    CHECK(plain.rays == 6 * (16 << 2) * 64);
+    CHECK(g.rays == plain.rays + 6 * (16 << 8) * (64 / final_gather_ray_share));
+    // Nothing reaches a threshold above every value: the plain gather.
+    const AmbientGather high = gather_ambient(scene, octree, held.sources(), 64, 1, 1, 10);
+    CHECK(high.rays == plain.rays);
+    CHECK(high.power == plain.power);
+}
+
+TEST_CASE("ambient gather: the final gather resolves the gap under a block beside a wall",
+          "[ambient]") {
+    // A 10 x 10 wall, a black block 0.3 in front of its middle, a black square of unshot
+    // radiosity 1 facing the wall from 8 away: the wall's one bounce is dark under the block
+    // and bright around it. At level 1 one cell covers half the wall and its field cannot dip
+    // under the block; the final gather (level 4) can. Reference: the plain gather at level 4
+    // with 1024 rays a point. Error: the mean of |B - B_ref| over a 20 x 20 grid of the wall,
+    // over the largest B_ref (measured: level 1 9.1 %, the final gather 2.1 %).
+    const Scene scene = scene_from(
+        "material grey  reflectance 0.5 0.5 0.5\n"
+        "material black reflectance 0 0 0\n"
+        "rectangle wall  grey   0 0 0   0 0 10   10 0 0\n"
+        "rectangle top   black  0 8 0   10 0 0   0 0 10\n"
+        "box block black  3 0.3 3  7 4.3 7\n");
+    const Octree octree = build_octree(scene);
+    const int wall = scene.find_surface("wall");
+    REQUIRE(scene.surfaces[wall].surface.evaluate(0.5, 0.5).normal.y == Approx(1));
+    const TestSources held = sources_for(scene, {1, 1, 1}, {"top"});
+    const AmbientGather reference = gather_ambient(scene, octree, held.sources(), 1024, 4);
+    const AmbientGather plain = gather_ambient(scene, octree, held.sources(), 256, 1);
+    const AmbientGather final = gather_ambient(scene, octree, held.sources(), 256, 1, 1, 1e-3);
+    REQUIRE(final.added[wall].level() == 4);
+    double largest = 0, e_plain = 0, e_final = 0;
+    for (int a = 0; a < 20; ++a)
+        for (int b = 0; b < 20; ++b) {
+            const double s = (a + 0.5) / 20, t = (b + 0.5) / 20;
+            const double ref = reference.added[wall].evaluate(s, t).g;
+            largest = std::max(largest, ref);
+            e_plain += std::fabs(plain.added[wall].evaluate(s, t).g - ref) / 400;
+            e_final += std::fabs(final.added[wall].evaluate(s, t).g - ref) / 400;
+        }
+    REQUIRE(largest > 0);
+    e_plain /= largest;
+    e_final /= largest;
+    test::report() << "wall beside a block: level 1 mean error " << 100 * e_plain
+                   << " % of the largest, final gather " << 100 * e_final << " %\n";
+    CHECK(e_final < 0.4 * e_plain);
+}

@@ -41,10 +41,11 @@ TEST_CASE("tutorial 09: the render and the path-traced points", "[tutorial]") {
 
     // The errors at these settings (quadrature results printed with 3 decimals; the margin is
     // 1.5 units of the last digit). Ten shots at depth 3 leave 13 % of the power unshot for the
-    // gathered ambient correction (11.221 / 93.212 % at sfront1 with the constant one); the
+    // gathered ambient correction and its final gather (2.370 / 18.455 % at floor_pen1 without
+    // the final gather; 11.221 / 93.212 % at sfront1 with the constant correction); the
     // chapter's page shows the defaults'.
-    CHECK(number_after(run.out, "mean relative error") == Approx(2.370).margin(1.5e-3));
-    CHECK(number_after(run.out, "max relative error") == Approx(18.455).margin(1.5e-3));
+    CHECK(number_after(run.out, "mean relative error") == Approx(2.463).margin(1.5e-3));
+    CHECK(number_after(run.out, "max relative error") == Approx(22.303).margin(1.5e-3));
     CHECK(run.out.find("(floor_pen1)") != std::string::npos);
 }
 

@@ -142,6 +142,13 @@ std::vector<OptionSpec> make_option_table() {
         integer_option("ambient_level", &S::ambient_level, 0, 4, "L",
                        "the ambient gather's points: the m x m Gauss points of every cell of "
                        "this level of each surface, and the field it adds at this level"),
+        switch_option("ambient_final", &S::ambient_final,
+                      "after the ambient gather, a surface whose gathered radiosity reaches 10 "
+                      "absolute tolerances, and whose cells are wider than 1/16 of the scene's "
+                      "diagonal, gathers once more at the finer level of such cells (at most 4), "
+                      "with a quarter of the rays, one bounce from what the gather makes every "
+                      "surface send (the final gather: the ambient light follows the shadows "
+                      "near a large surface)"),
         switch_option("limiter", &S::limiter,
                       "where a shot's increment rings above rho_max x the shooter's largest "
                       "coefficient its covering coefficients are clipped to that bound, and "

@@ -70,14 +70,15 @@ struct SolverSettings {
     ShadowSetting shadows = ShadowSetting::Auto;
     double tolerance = 2e-3;  // accuracy relative to the scene's radiosity scale
     UnifySetting unify = UnifySetting::Projection;
-    bool ambient = true;     // ambient correction of the unshot power at the end
-    int ambient_rays = 256;  //   gathered by this many rays per Gauss point (0: a constant)
-    int ambient_level = 1;   //   at the Gauss points of this level's cells
-    bool limiter = true;     // increments and final fields clipped to their physical bounds
-    bool hidden = true;      // hidden regions take their visible neighbours' values
-    int shooter_level = 3;   // a shooter's unshot field coarsened to at most this level
-    int contact_depth = 2;   // receiver cells touching a planar shooter split to at
-                             //   least this level (0: off)
+    bool ambient = true;        // ambient correction of the unshot power at the end
+    int ambient_rays = 256;     //   gathered by this many rays per Gauss point (0: a constant)
+    int ambient_level = 1;      //   at the Gauss points of this level's cells
+    bool ambient_final = true;  //   and bright surfaces once more, finer (the final gather)
+    bool limiter = true;        // increments and final fields clipped to their physical bounds
+    bool hidden = true;         // hidden regions take their visible neighbours' values
+    int shooter_level = 3;      // a shooter's unshot field coarsened to at most this level
+    int contact_depth = 2;      // receiver cells touching a planar shooter split to at
+                                //   least this level (0: off)
     OracleSetting oracle = OracleSetting::Hybrid;
     OracleSetting contact_oracle = OracleSetting::Means;
     double weak_transfer = 0.3;  // a transfer whose root samples are below this many

@@ -75,9 +75,115 @@ double ambient_gather_bytes(const std::vector<int>& order, int level, int rays) 
     return samples * (double(rays) * sizeof(GatherHit) + 6 * sizeof(Rgb) + sizeof(double) + 1);
 }
 
+int final_gather_level(const Surface& surface, double diagonal, int level) {
+    const double cell = diagonal / final_gather_cells;
+    const double size =
+        std::max(length(surface.evaluate(1, 0).position - surface.evaluate(0, 1).position),
+                 length(surface.evaluate(1, 1).position - surface.evaluate(0, 0).position));
+    int l = level;
+    while (l < max_ambient_level && size / double(1 << l) > cell) ++l;
+    return l;
+}
+
+namespace {
+
+/// The final gather (ambient_gather.h): the surfaces whose gathered radiosity reaches
+/// `threshold` gather once more at their final_gather_level, one bounce from U + R (R the
+/// converged gather's fields), and out's fields and power are replaced by theirs.
+void final_gather(const Scene& scene, const Octree& octree, const AmbientSources& sources,
+                  int level, double threshold, std::uint64_t seed,
+                  const std::vector<Rgb>& reflected, const std::vector<double>& weight,
+                  const std::vector<int>& first, int rays_asked, AmbientGather* out) {
+    const int n = static_cast<int>(scene.surfaces.size());
+    const Box3 box = octree.bounds();
+    const double scale = box.empty() ? 1.0 : length(box.extent());
+    // R_j, what the converged gather makes every surface send, and which surfaces refine.
+    std::vector<PolynomialPatches> sent(n);
+    std::vector<bool> sends(n, false), has_unshot(n);
+    std::vector<int> final_level(n, -1);
+    for (int j = 0; j < n; ++j) {
+        has_unshot[j] = nonzero(sources.unshot[j]);
+        double largest = 0;
+        for (int item = first[j]; item < first[j + 1]; ++item)
+            largest = std::max(largest, max_abs(reflected[item]));
+        if (largest == 0) continue;
+        sends[j] = true;
+        sent[j] = PolynomialPatches(l2_projection_of_samples(
+            sources.order[j], level, sources.order[j], &reflected[first[j]]));
+        const int l = final_gather_level(scene.surfaces[j].surface, scale, level);
+        if (largest >= threshold && l > level) final_level[j] = l;
+    }
+    std::vector<int> start(n + 1, 0);
+    for (int i = 0; i < n; ++i) {
+        const int side = final_level[i] < 0 ? 0 : sample_side(sources.order[i], final_level[i]);
+        start[i + 1] = start[i] + side * side;
+    }
+    const int n_samples = start[n];
+    if (n_samples == 0) return;
+    const int rays = gather_rays_per_point(
+        std::max(ambient_min_rays, rays_asked / final_gather_ray_share), n_samples);
+    auto surface_of = [&](int item) {
+        return int(std::upper_bound(start.begin(), start.end(), item) - start.begin()) - 1;
+    };
+    std::vector<Rgb> values(n_samples);         // rho H (H for an irradiance field)
+    std::vector<double> power(n_samples, 0.0);  // Gauss weight x A x rho H, summed
+    std::vector<std::uint8_t> gathers(n_samples, 0);
+    parallel_for(n_samples, [&](int item) {
+        const int i = surface_of(item), l = final_level[i];
+        const int m = sources.order[i], k = item - start[i], side = sample_side(m, l);
+        const int cells = 1 << l, S = k / side, T = k % side, a = S % m, b = T % m;
+        const GaussLegendre rule = gauss_legendre(m);
+        const double s = projection_sample_coordinate(rule, S, l);
+        const double t = projection_sample_coordinate(rule, T, l);
+        const Surface& surface = scene.surfaces[i].surface;
+        const Vec2 q =
+            i < int(sources.hidden.size()) ? sources.hidden[i].substitute(s, t) : Vec2{s, t};
+        const SurfacePoint p = surface.evaluate(q.x, q.y);
+        if (!(p.area_factor > 0)) return;
+        const CosineFrame frame(p.normal);
+        const Vec3 origin = p.position + (1e-7 * scale) * p.normal;
+        const std::uint64_t key =
+            hash_seed(seed ^ 0x66696e616cULL, std::uint64_t(i), std::uint64_t(k));
+        const double shift_1 = uniform01(key, 0), shift_2 = uniform01(key, 1);
+        Rgb sum;
+        for (int r = 0; r < rays; ++r) {
+            const Vec3 dir = frame.direction(wrap01((r + 0.5) / rays + shift_1),
+                                             wrap01(radical_inverse_2(std::uint32_t(r)) + shift_2));
+            const std::optional<Hit> hit =
+                octree.closest_hit(Ray{origin, dir, 0, HUGE_VAL}, RayFilter{-1, -1, true});
+            if (!hit || dot(octree.polygons()[hit->polygon].normal(), dir) > 0) continue;
+            if (has_unshot[hit->surface])
+                sum += sources.unshot[hit->surface].evaluate(hit->uv.x, hit->uv.y);
+            if (sends[hit->surface]) sum += sent[hit->surface](hit->uv.x, hit->uv.y);
+        }
+        const Rgb H = (1.0 / rays) * sum;
+        const Rgb rho = scene.material_of(i).reflectance.value(s, t);
+        const Rgb rhoH = rho * H;
+        values[item] = sources.irradiance[i] ? H : rhoH;
+        power[item] = 0.25 * rule.w[a] * rule.w[b] / (double(cells) * cells) *
+                      surface.area_factor(s, t) * (rhoH.r + rhoH.g + rhoH.b);
+        gathers[item] = 1;
+    });
+    for (int i = 0; i < n; ++i) {
+        if (final_level[i] < 0) continue;
+        // What the first gather added on i leaves the power, the final gather's enters it.
+        for (int item = first[i]; item < first[i + 1]; ++item)
+            out->power -=
+                weight[item] * (reflected[item].r + reflected[item].g + reflected[item].b);
+        for (int item = start[i]; item < start[i + 1]; ++item) {
+            out->power += power[item];
+            out->rays += gathers[item] ? rays : 0;
+        }
+        out->added[i] = l2_projection_of_samples(sources.order[i], final_level[i], sources.order[i],
+                                                 &values[start[i]]);
+    }
+}
+
+}  // namespace
+
 AmbientGather gather_ambient(const Scene& scene, const Octree& octree,
                              const AmbientSources& sources, int rays_asked, int level,
-                             std::uint64_t seed) {
+                             std::uint64_t seed, double final_threshold) {
     const int n = static_cast<int>(scene.surfaces.size());
     MBR_CHECK_MSG(rays_asked >= 1, "ambient gather with " << rays_asked << " rays");
     MBR_CHECK_MSG(level >= 0 && level <= max_ambient_level, "ambient gather at level " << level);
@@ -200,6 +306,9 @@ AmbientGather gather_ambient(const Scene& scene, const Octree& octree,
             out.added[i] = l2_projection_of_samples(sources.order[i], level, sources.order[i],
                                                     &samples[first[i]]);
     }
+    if (final_threshold > 0)
+        final_gather(scene, octree, sources, level, final_threshold, seed, reflected, weight, first,
+                     rays_asked, &out);
     return out;
 }
 

@@ -72,8 +72,31 @@ constexpr int max_ambient_level = 4;
 /// solved by Jacobi iteration from R = 0 (U's first bounce, then each further bounce), until
 /// the added power changes by less than ambient_iteration_tolerance of itself. The samples
 /// projected are rho H (H itself for an irradiance field). `octree` is build_octree(scene).
+///
+/// The final gather (beyond the gather above, when final_threshold > 0): a surface whose
+/// gathered radiosity rho H reaches final_threshold somewhere, and whose cells at `level` are
+/// wider than 1 / final_gather_cells of the scene's bounding-box diagonal, gathers once more
+/// at the m x m Gauss points of every cell of its final_gather_level, a quarter of the rays
+/// a point (final_gather_ray_share), one bounce from what the converged gather makes every surface
+/// send (U_j + R_j): the ambient light of a large surface then follows the shadows of what stands
+/// near it (a block a third of a unit from a wall ten units wide) instead of one field over half
+/// the wall.
 AmbientGather gather_ambient(const Scene& scene, const Octree& octree,
                              const AmbientSources& sources, int rays, int level = 0,
-                             std::uint64_t seed = 1);
+                             std::uint64_t seed = 1, double final_threshold = 0);
+
+/// The final gather (DESIGN, measured on cube.mgf and the Cornell box: docs/method.md, "The
+/// final gather"): its cells are no wider than 1 / final_gather_cells of the scene's diagonal
+/// (up to max_ambient_level); its points take 1 / final_gather_ray_share of the gather's rays
+/// (at least ambient_min_rays: the projection averages m^2 points a cell); the solver asks it
+/// of the surfaces whose gathered radiosity reaches final_gather_share absolute tolerances.
+constexpr double final_gather_cells = 16;
+constexpr int final_gather_ray_share = 4;
+constexpr double final_gather_share = 10;
+
+/// The level at which the final gather takes `surface`: the first from `level` at which its
+/// cells (its longer diagonal / 2^level) are no wider than diagonal / final_gather_cells, at
+/// most max_ambient_level.
+int final_gather_level(const Surface& surface, double diagonal, int level);
 
 }  // namespace mbr

@@ -140,9 +140,12 @@ namespace {
 
 OracleTest oracle_test(OracleSetting s) {
     switch (s) {
-        case OracleSetting::Hybrid: return OracleTest::Hybrid;
-        case OracleSetting::Interpolation: return OracleTest::Interpolation;
-        case OracleSetting::Means: break;
+        case OracleSetting::Hybrid:
+            return OracleTest::Hybrid;
+        case OracleSetting::Interpolation:
+            return OracleTest::Interpolation;
+        case OracleSetting::Means:
+            break;
     }
     return OracleTest::Means;
 }
@@ -217,6 +220,7 @@ SolverOptions solver_options(const SolverSettings& s) {
     o.ambient = s.ambient;
     o.ambient_rays = s.ambient_rays;
     o.ambient_level = s.ambient_level;
+    o.ambient_final = s.ambient_final;
     static_assert(max_ambient_level == 4, "the option table's range of ambient_level");
     o.limiter = s.limiter;
     o.irradiance_fields = s.texture_field == TextureFieldSetting::Irradiance;
@@ -818,8 +822,10 @@ Solution ProgressiveSolver::finish() {
                                  out.quantity[i] == FieldQuantity::irradiance);
         const AmbientSources sources{solution_.unshot, order_, irradiance, hidden_};
         const double gather_start = now();
-        const AmbientGather gather =
-            gather_ambient(scene_, octree_, sources, options_.ambient_rays, options_.ambient_level);
+        const AmbientGather gather = gather_ambient(
+            scene_, octree_, sources, options_.ambient_rays, options_.ambient_level, 1,
+            options_.ambient_final ? final_gather_share * options_.tolerance * radiosity_scale_
+                                   : 0.0);
         st.ambient_seconds = now() - gather_start;
         for (size_t i = 0; i < gather.added.size(); ++i)
             if (!gather.added[i].empty()) out.radiosity[i].add(gather.added[i]);

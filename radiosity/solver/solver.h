@@ -76,6 +76,7 @@ struct SolverOptions {
                                     //   surface (ambient_gather.h, gather_rays_per_point); 0:
                                     //   the constant per surface
     int ambient_level = 1;          //   at the Gauss points of this level's cells
+    bool ambient_final = true;      //   and the final gather after it (ambient_gather.h)
 };
 
 /// The scene's `set` statements as solver options (shadows: the scene's method and rays).
