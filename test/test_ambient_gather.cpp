@@ -50,6 +50,19 @@ TestSources sources_for(const Scene& scene, Rgb unshot, const std::vector<std::s
     return s;
 }
 
+/// A unit cube seen from inside, reflectance 0.5.
+Scene closed_box() {
+    return scene_from(
+        "material white reflectance 0.5 0.5 0.5\n"
+        "box cube white  0 0 0  1 1 1  inward\n");
+}
+
+std::vector<std::string> surface_names(const Scene& scene) {
+    std::vector<std::string> all;
+    for (const SceneSurface& s : scene.surfaces) all.push_back(s.name);
+    return all;
+}
+
 /// The m-point Gauss-Legendre nodes of [0,1] for m = 4, where the added field interpolates its
 /// samples.
 std::vector<double> gauss_nodes_01() {
@@ -65,13 +78,9 @@ TEST_CASE("ambient gather: a closed box of uniform unshot radiosity gains U rho 
           "[ambient]") {
     // Every ray from inside a closed box meets a front face, all of them leaving U + R: the
     // Jacobi iteration sums the geometric series rho + rho^2 + ... = rho / (1 - rho) = 1.
-    const Scene scene = scene_from(
-        "material white reflectance 0.5 0.5 0.5\n"
-        "box cube white  0 0 0  1 1 1  inward\n");
+    const Scene scene = closed_box();
     const Octree octree = build_octree(scene);
-    std::vector<std::string> all;
-    for (const SceneSurface& s : scene.surfaces) all.push_back(s.name);
-    const TestSources held = sources_for(scene, {1, 1, 1}, all);
+    const TestSources held = sources_for(scene, {1, 1, 1}, surface_names(scene));
     for (int level : {0, 1, 2}) {
         const AmbientGather g = gather_ambient(scene, octree, held.sources(), 16, level);
         REQUIRE(g.added.size() == 6);
@@ -211,13 +220,9 @@ TEST_CASE("ambient gather: the final gather keeps a closed box exact at its fine
           "[ambient]") {
     // Unit cube (diagonal 1.73, cells of 0.108): each face (diagonal 1.41) gathers once more at
     // level 4, one bounce from U + R with R converged: rho (U + R) = 0.5 (1 + 1) = 1 again.
-    const Scene scene = scene_from(
-        "material white reflectance 0.5 0.5 0.5\n"
-        "box cube white  0 0 0  1 1 1  inward\n");
+    const Scene scene = closed_box();
     const Octree octree = build_octree(scene);
-    std::vector<std::string> all;
-    for (const SceneSurface& s : scene.surfaces) all.push_back(s.name);
-    const TestSources held = sources_for(scene, {1, 1, 1}, all);
+    const TestSources held = sources_for(scene, {1, 1, 1}, surface_names(scene));
     const AmbientGather plain = gather_ambient(scene, octree, held.sources(), 64, 1);
     const AmbientGather g = gather_ambient(scene, octree, held.sources(), 64, 1, 1, 0.5);
     REQUIRE(g.added.size() == 6);

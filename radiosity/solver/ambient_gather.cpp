@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 #include "math/check.h"
 #include "math/gauss_legendre.h"
@@ -59,6 +60,45 @@ std::vector<int> sample_offsets(const std::vector<int>& order, int level) {
         first[i + 1] = first[i] + side * side;
     }
     return first;
+}
+
+/// Where a gather sample's rays start: 1e-7 of the scene in front of the true surface at the
+/// sample (a hidden point at its substitute, hidden_regions.h, as every sample does), its
+/// cosine frame and the shifts of its Hammersley set.
+struct GatherOrigin {
+    Vec3 origin;
+    CosineFrame frame;
+    double shift_1, shift_2;
+};
+
+/// The origin of the sample at (s, t) of `surface` (nothing for a degenerate point, which
+/// gathers nothing); `key` seeds its shifts.
+std::optional<GatherOrigin> gather_origin(const Surface& surface, const HiddenMask* hidden,
+                                          double s, double t, double scale, std::uint64_t key) {
+    const Vec2 q = hidden ? hidden->substitute(s, t) : Vec2{s, t};
+    const SurfacePoint p = surface.evaluate(q.x, q.y);
+    if (!(p.area_factor > 0)) return std::nullopt;
+    // DESIGN: as find_hidden's rays, from the true surface 1e-7 of the scene in front.
+    return GatherOrigin{p.position + (1e-7 * scale) * p.normal, CosineFrame(p.normal),
+                        uniform01(key, 0), uniform01(key, 1)};
+}
+
+/// What ray r of a sample's `rays` meets first: a front face of `surface` at (u, v).
+struct RayHit {
+    int surface;
+    double u, v;
+};
+
+/// Ray r of `rays` from a gather origin: the Hammersley point r, shifted (Cranley and
+/// Patterson 1976), lifted to the cosine-distributed hemisphere (density cos theta / pi); a
+/// back face or nothing counts nothing.
+std::optional<RayHit> gather_ray(const Octree& octree, const GatherOrigin& o, int r, int rays) {
+    const Vec3 dir = o.frame.direction(wrap01((r + 0.5) / rays + o.shift_1),
+                                       wrap01(radical_inverse_2(std::uint32_t(r)) + o.shift_2));
+    const std::optional<Hit> hit =
+        octree.closest_hit(Ray{o.origin, dir, 0, HUGE_VAL}, RayFilter{-1, -1, true});
+    if (!hit || dot(octree.polygons()[hit->polygon].normal(), dir) > 0) return std::nullopt;
+    return RayHit{hit->surface, hit->uv.x, hit->uv.y};
 }
 
 }  // namespace
@@ -136,25 +176,16 @@ void final_gather(const Scene& scene, const Octree& octree, const AmbientSources
         const double s = projection_sample_coordinate(rule, S, l);
         const double t = projection_sample_coordinate(rule, T, l);
         const Surface& surface = scene.surfaces[i].surface;
-        const Vec2 q =
-            i < int(sources.hidden.size()) ? sources.hidden[i].substitute(s, t) : Vec2{s, t};
-        const SurfacePoint p = surface.evaluate(q.x, q.y);
-        if (!(p.area_factor > 0)) return;
-        const CosineFrame frame(p.normal);
-        const Vec3 origin = p.position + (1e-7 * scale) * p.normal;
-        const std::uint64_t key =
-            hash_seed(seed ^ 0x66696e616cULL, std::uint64_t(i), std::uint64_t(k));
-        const double shift_1 = uniform01(key, 0), shift_2 = uniform01(key, 1);
+        const std::optional<GatherOrigin> o = gather_origin(
+            surface, i < int(sources.hidden.size()) ? &sources.hidden[i] : nullptr, s, t, scale,
+            hash_seed(seed ^ 0x66696e616cULL, std::uint64_t(i), std::uint64_t(k)));
+        if (!o) return;
         Rgb sum;
         for (int r = 0; r < rays; ++r) {
-            const Vec3 dir = frame.direction(wrap01((r + 0.5) / rays + shift_1),
-                                             wrap01(radical_inverse_2(std::uint32_t(r)) + shift_2));
-            const std::optional<Hit> hit =
-                octree.closest_hit(Ray{origin, dir, 0, HUGE_VAL}, RayFilter{-1, -1, true});
-            if (!hit || dot(octree.polygons()[hit->polygon].normal(), dir) > 0) continue;
-            if (has_unshot[hit->surface])
-                sum += sources.unshot[hit->surface].evaluate(hit->uv.x, hit->uv.y);
-            if (sends[hit->surface]) sum += sent[hit->surface](hit->uv.x, hit->uv.y);
+            const std::optional<RayHit> h = gather_ray(octree, *o, r, rays);
+            if (!h) continue;
+            if (has_unshot[h->surface]) sum += sources.unshot[h->surface].evaluate(h->u, h->v);
+            if (sends[h->surface]) sum += sent[h->surface](h->u, h->v);
         }
         const Rgb H = (1.0 / rays) * sum;
         const Rgb rho = scene.material_of(i).reflectance.value(s, t);
@@ -223,30 +254,17 @@ AmbientGather gather_ambient(const Scene& scene, const Octree& octree,
             0.25 * rule.w[a] * rule.w[b] / (double(cells) * cells) * surface.area_factor(s, t);
         rho[item] = material.reflectance.value(s, t);
         if (max_abs(material.reflectance.maximum()) == 0) return;  // reflects nothing
-        // A hidden point gathers at its substitute (hidden_regions.h), as every sample does.
-        const Vec2 q =
-            i < int(sources.hidden.size()) ? sources.hidden[i].substitute(s, t) : Vec2{s, t};
-        const SurfacePoint p = surface.evaluate(q.x, q.y);
-        if (!(p.area_factor > 0)) return;  // a degenerate point: nothing gathered
-        const CosineFrame frame(p.normal);
-        // DESIGN: as find_hidden's rays, from the true surface 1e-7 of the scene in front.
-        const Vec3 origin = p.position + (1e-7 * scale) * p.normal;
-        const std::uint64_t key =
-            hash_seed(seed ^ 0x616d6269656e74ULL, std::uint64_t(i), std::uint64_t(k));
-        const double shift_1 = uniform01(key, 0), shift_2 = uniform01(key, 1);
+        const std::optional<GatherOrigin> o = gather_origin(
+            surface, i < int(sources.hidden.size()) ? &sources.hidden[i] : nullptr, s, t, scale,
+            hash_seed(seed ^ 0x616d6269656e74ULL, std::uint64_t(i), std::uint64_t(k)));
+        if (!o) return;  // a degenerate point: nothing gathered
         GatherHit* kept = &hits[size_t(item) * rays];
         Rgb sum;
         for (int r = 0; r < rays; ++r) {
-            // Hammersley point r of `rays`, shifted (Cranley and Patterson 1976), lifted to the
-            // cosine-distributed hemisphere (density cos theta / pi).
-            const Vec3 dir = frame.direction(wrap01((r + 0.5) / rays + shift_1),
-                                             wrap01(radical_inverse_2(std::uint32_t(r)) + shift_2));
-            const std::optional<Hit> hit =
-                octree.closest_hit(Ray{origin, dir, 0, HUGE_VAL}, RayFilter{-1, -1, true});
-            if (!hit || dot(octree.polygons()[hit->polygon].normal(), dir) > 0) continue;
-            kept[r] = {hit->surface, float(hit->uv.x), float(hit->uv.y)};
-            if (has_unshot[hit->surface])
-                sum += sources.unshot[hit->surface].evaluate(hit->uv.x, hit->uv.y);
+            const std::optional<RayHit> h = gather_ray(octree, *o, r, rays);
+            if (!h) continue;
+            kept[r] = {h->surface, float(h->u), float(h->v)};
+            if (has_unshot[h->surface]) sum += sources.unshot[h->surface].evaluate(h->u, h->v);
         }
         first_bounce[item] = (1.0 / rays) * sum;
         gathers[item] = 1;
