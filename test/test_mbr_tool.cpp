@@ -838,7 +838,7 @@ TEST_CASE("mbr_tool: the summary says why the solve stopped, and the total left 
     // constant one: a warning says how far its placement goes (without the correction the
     // missing light is plain to see in the figure).
     CHECK_THAT(limited, Contains("% of the power is still unshot; the ambient gather places it "
-                                 "with one coarse field per surface"));
+                                 "with coarse fields (finer on large bright surfaces)"));
     const std::string constant = summary({"--max-shots", "1", "--ambient-rays", "0"});
     CHECK_THAT(constant, Contains("% of the power is still unshot; the ambient correction "
                                   "restores its total, not where it falls"));

@@ -475,14 +475,16 @@ void print_summary(std::ostream& os, const SceneRun& run, const SolveStats& st) 
     // DESIGN: the constant ambient correction restores the unshot power's total but not where
     // it falls; beyond about 1 % unshot single points go wrong by several per cent (cube.mgf:
     // 1.4 % unshot, 2.9 % mean error at 196 random points; 5.9 %, 15.4 %). The gather places
-    // it, but as one coarse field per surface (level 1): at 5.9 % unshot cube.mgf reads 0.99 %
-    // mean and 10.9 % at its worst point (docs/method.md, "Ambient correction, gathered").
+    // it, but as coarse fields (level 1, up to level 4 on large bright surfaces by the final
+    // gather): at 5.9 % unshot cube.mgf reads 0.68 % mean and 7.1 % at its worst point
+    // (docs/method.md, "Ambient correction, gathered" and "The final gather").
     const double unshot = percent_of_emitted(st.unshot_power, st);
     const bool gathered = run.options.ambient_rays > 0;
     if (run.options.ambient && unshot > (gathered ? 5 : 1))
         os << "warning: " << cell_g(unshot, 3) << " % of the power is still unshot; "
-           << (gathered ? "the ambient gather places it with one coarse field per surface, so "
-                          "its shadows are soft and dark points may be off by more than that"
+           << (gathered ? "the ambient gather places it with coarse fields (finer on large "
+                          "bright surfaces), so its shadows are soft and dark points may be off "
+                          "by more than that"
                         : "the ambient correction restores its total, not where it falls, so "
                           "single points may be off by more than that")
            << " (raise --max-shots or lower --convergence for the right light)\n";
