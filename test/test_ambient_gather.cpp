@@ -137,18 +137,27 @@ TEST_CASE("ambient gather: results do not depend on the thread count", "[ambient
     const TestSources held = sources_for(scene, {1, 0.5, 0.25}, {"light", "floor", "short_top"});
     const AmbientSources sources = held.sources();
     const int before = omp_get_max_threads();
-    omp_set_num_threads(1);
-    const AmbientGather one = gather_ambient(scene, octree, sources, 32, 1);
-    omp_set_num_threads(2);
-    const AmbientGather two = gather_ambient(scene, octree, sources, 32, 1);
-    omp_set_num_threads(before);
-    CHECK(one.power == two.power);
-    CHECK(one.iterations == two.iterations);
-    for (size_t i = 0; i < one.added.size(); ++i) {
-        CAPTURE(scene.surfaces[i].name);
-        REQUIRE(one.added[i].empty() == two.added[i].empty());
-        for (int c = 0; c < 3 && !one.added[i].empty(); ++c)
-            CHECK(one.added[i].channel(c).a == two.added[i].channel(c).a);
+    // With the final gather too (a threshold every lit surface reaches: the walls gather again
+    // at level 3 or 4).
+    for (double final_threshold : {0.0, 1e-6}) {
+        CAPTURE(final_threshold);
+        omp_set_num_threads(1);
+        const AmbientGather one = gather_ambient(scene, octree, sources, 32, 1, 1, final_threshold);
+        omp_set_num_threads(2);
+        const AmbientGather two = gather_ambient(scene, octree, sources, 32, 1, 1, final_threshold);
+        omp_set_num_threads(before);
+        CHECK(one.power == two.power);
+        CHECK(one.rays == two.rays);
+        CHECK(one.iterations == two.iterations);
+        int finer = 0;
+        for (size_t i = 0; i < one.added.size(); ++i) {
+            CAPTURE(scene.surfaces[i].name);
+            REQUIRE(one.added[i].empty() == two.added[i].empty());
+            if (!one.added[i].empty() && one.added[i].level() > 1) ++finer;
+            for (int c = 0; c < 3 && !one.added[i].empty(); ++c)
+                CHECK(one.added[i].channel(c).a == two.added[i].channel(c).a);
+        }
+        CHECK((finer > 0) == (final_threshold > 0));
     }
 }
 #endif
