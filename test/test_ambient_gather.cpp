@@ -292,3 +292,36 @@ TEST_CASE("ambient gather: the final gather resolves the gap under a block besid
                    << " % of the largest, final gather " << 100 * e_final << " %\n";
     CHECK(e_final < 0.4 * e_plain);
 }
+
+TEST_CASE(
+    "ambient gather: the final gather leaves an unshot light's first bounce at the gather's "
+    "level",
+    "[ambient]") {
+    // A small light still unshot above a 10 x 10 floor: its first bounce is direct light, which
+    // a few rays a point turn into noise at a fine level (blotches under 54 small lamps), so the
+    // final gather keeps it as the level-1 field of the first gather. Nothing else bounces here,
+    // so the final field (level 4) is that level-1 field, re-projected exactly (the level-4
+    // splines hold the level-1 ones and the Gauss rule integrates their products exactly).
+    const Scene scene = scene_from(
+        "material grey reflectance 0.5 0.5 0.5\n"
+        "material lamp reflectance 0 0 0 emission 1 1 1\n"
+        "rectangle floor grey  0 0 0   0 0 10   10 0 0\n"
+        "rectangle light lamp  4.5 3 4.5   1 0 0   0 0 1\n");
+    const Octree octree = build_octree(scene);
+    const int floor = scene.find_surface("floor");
+    REQUIRE(scene.surfaces[scene.find_surface("light")].surface.evaluate(0.5, 0.5).normal.y ==
+            Approx(-1));
+    const TestSources held = sources_for(scene, {1, 1, 1}, {"light"});
+    const AmbientGather plain = gather_ambient(scene, octree, held.sources(), 64, 1);
+    const AmbientGather final = gather_ambient(scene, octree, held.sources(), 64, 1, 1, 1e-12);
+    REQUIRE(plain.added[floor].level() == 1);
+    REQUIRE(final.added[floor].level() == 4);
+    CHECK(final.rays > plain.rays);
+    for (double s : {0.1, 0.37, 0.5, 0.81})
+        for (double t : {0.05, 0.5, 0.66}) {
+            CAPTURE(s, t);
+            CHECK(final.added[floor].evaluate(s, t).g ==
+                  Approx(plain.added[floor].evaluate(s, t).g).epsilon(1e-9));
+        }
+    CHECK(final.power == Approx(plain.power).epsilon(1e-9));
+}

@@ -133,16 +133,18 @@ namespace {
 void final_gather(const Scene& scene, const Octree& octree, const AmbientSources& sources,
                   int level, double threshold, std::uint64_t seed,
                   const std::vector<Rgb>& reflected, const std::vector<double>& weight,
-                  const std::vector<int>& first, int rays_asked, AmbientGather* out) {
+                  const std::vector<Rgb>& first_lights, const std::vector<int>& first,
+                  int rays_asked, AmbientGather* out) {
     const int n = static_cast<int>(scene.surfaces.size());
     const Box3 box = octree.bounds();
     const double scale = box.empty() ? 1.0 : length(box.extent());
     // R_j, what the converged gather makes every surface send, and which surfaces refine.
     std::vector<PolynomialPatches> sent(n);
-    std::vector<bool> sends(n, false), has_unshot(n);
+    std::vector<bool> sends(n, false), has_unshot(n), emits(n);
     std::vector<int> final_level(n, -1);
     for (int j = 0; j < n; ++j) {
         has_unshot[j] = nonzero(sources.unshot[j]);
+        emits[j] = scene.material_of(j).emits();
         double largest = 0;
         for (int item = first[j]; item < first[j + 1]; ++item)
             largest = std::max(largest, max_abs(reflected[item]));
@@ -152,6 +154,19 @@ void final_gather(const Scene& scene, const Octree& octree, const AmbientSources
             sources.order[j], level, sources.order[j], &reflected[first[j]]));
         const int l = final_gather_level(scene.surfaces[j].surface, scale, level);
         if (largest >= threshold && l > level) final_level[j] = l;
+    }
+    // The light of emitters still unshot stays at the first gather's level: a few rays a point
+    // that meet small bright lights are noise at a fine level (corridor.mgf after 3 shots, 54
+    // lamps unshot: blotches), and that light is the next shots' to place.
+    std::vector<PolynomialPatches> lights(n);
+    std::vector<bool> has_lights(n, false);
+    for (int i = 0; i < n; ++i) {
+        if (final_level[i] < 0) continue;
+        for (int item = first[i]; item < first[i + 1]; ++item)
+            has_lights[i] = has_lights[i] || max_abs(first_lights[item]) > 0;
+        if (has_lights[i])
+            lights[i] = PolynomialPatches(l2_projection_of_samples(
+                sources.order[i], level, sources.order[i], &first_lights[first[i]]));
     }
     std::vector<int> start(n + 1, 0);
     for (int i = 0; i < n; ++i) {
@@ -184,10 +199,11 @@ void final_gather(const Scene& scene, const Octree& octree, const AmbientSources
         for (int r = 0; r < rays; ++r) {
             const std::optional<RayHit> h = gather_ray(octree, *o, r, rays);
             if (!h) continue;
-            if (has_unshot[h->surface]) sum += sources.unshot[h->surface].evaluate(h->u, h->v);
+            if (has_unshot[h->surface] && !emits[h->surface])
+                sum += sources.unshot[h->surface].evaluate(h->u, h->v);
             if (sends[h->surface]) sum += sent[h->surface](h->u, h->v);
         }
-        const Rgb H = (1.0 / rays) * sum;
+        const Rgb H = (1.0 / rays) * sum + (has_lights[i] ? lights[i](s, t) : Rgb{});
         const Rgb rho = scene.material_of(i).reflectance.value(s, t);
         const Rgb rhoH = rho * H;
         values[item] = sources.irradiance[i] ? H : rhoH;
@@ -222,8 +238,11 @@ AmbientGather gather_ambient(const Scene& scene, const Octree& octree,
               int(sources.irradiance.size()) == n);
     // U_j is read once per ray that meets j, by SplineField::evaluate (PolynomialPatches of
     // fields at level 6 would hold 1.5 MiB a surface).
-    std::vector<bool> has_unshot(n);
-    for (int j = 0; j < n; ++j) has_unshot[j] = nonzero(sources.unshot[j]);
+    std::vector<bool> has_unshot(n), emits(n);
+    for (int j = 0; j < n; ++j) {
+        has_unshot[j] = nonzero(sources.unshot[j]);
+        emits[j] = scene.material_of(j).emits();
+    }
 
     const Box3 box = octree.bounds();
     const double scale = box.empty() ? 1.0 : length(box.extent());
@@ -235,6 +254,7 @@ AmbientGather gather_ambient(const Scene& scene, const Octree& octree,
     };
     std::vector<GatherHit> hits(size_t(n_samples) * rays, GatherHit{-1, 0, 0});
     std::vector<Rgb> first_bounce(n_samples);    // mean U_j(u, v) over the sample's rays
+    std::vector<Rgb> first_lights(n_samples);    //   of which from emitting surfaces
     std::vector<Rgb> rho(n_samples);             // rho(s_a, t_b)
     std::vector<double> weight(n_samples, 0.0);  // Gauss weight x A(s_a, t_b), for the power
     std::vector<std::uint8_t> gathers(n_samples, 0);
@@ -259,14 +279,18 @@ AmbientGather gather_ambient(const Scene& scene, const Octree& octree,
             hash_seed(seed ^ 0x616d6269656e74ULL, std::uint64_t(i), std::uint64_t(k)));
         if (!o) return;  // a degenerate point: nothing gathered
         GatherHit* kept = &hits[size_t(item) * rays];
-        Rgb sum;
+        Rgb sum, from_lights;
         for (int r = 0; r < rays; ++r) {
             const std::optional<RayHit> h = gather_ray(octree, *o, r, rays);
             if (!h) continue;
             kept[r] = {h->surface, float(h->u), float(h->v)};
-            if (has_unshot[h->surface]) sum += sources.unshot[h->surface].evaluate(h->u, h->v);
+            if (!has_unshot[h->surface]) continue;
+            const Rgb u = sources.unshot[h->surface].evaluate(h->u, h->v);
+            sum += u;
+            if (emits[h->surface]) from_lights += u;
         }
         first_bounce[item] = (1.0 / rays) * sum;
+        first_lights[item] = (1.0 / rays) * from_lights;
         gathers[item] = 1;
     });
 
@@ -325,8 +349,8 @@ AmbientGather gather_ambient(const Scene& scene, const Octree& octree,
                                                     &samples[first[i]]);
     }
     if (final_threshold > 0)
-        final_gather(scene, octree, sources, level, final_threshold, seed, reflected, weight, first,
-                     rays_asked, &out);
+        final_gather(scene, octree, sources, level, final_threshold, seed, reflected, weight,
+                     first_lights, first, rays_asked, &out);
     return out;
 }
 
