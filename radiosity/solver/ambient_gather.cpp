@@ -62,6 +62,23 @@ std::vector<int> sample_offsets(const std::vector<int>& order, int level) {
     return first;
 }
 
+/// Sample k of a surface's samples at `level` (l2_projection_of_samples' order, m Gauss points
+/// a cell in each direction): its parameters and its weight in the surface's power (the Gauss
+/// weight times A).
+struct GatherSample {
+    double s, t, weight;
+};
+
+GatherSample gather_sample(const Surface& surface, int m, int level, int k) {
+    const int side = sample_side(m, level), cells = 1 << level;
+    const int S = k / side, T = k % side, a = S % m, b = T % m;
+    const GaussLegendre rule = gauss_legendre(m);
+    const double s = projection_sample_coordinate(rule, S, level);
+    const double t = projection_sample_coordinate(rule, T, level);
+    return {s, t,
+            0.25 * rule.w[a] * rule.w[b] / (double(cells) * cells) * surface.area_factor(s, t)};
+}
+
 /// Where a gather sample's rays start: 1e-7 of the scene in front of the true surface at the
 /// sample (a hidden point at its substitute, hidden_regions.h, as every sample does), its
 /// cosine frame and the shifts of its Hammersley set.
@@ -127,24 +144,37 @@ int final_gather_level(const Surface& surface, double diagonal, int level) {
 
 namespace {
 
+/// What the converged first gather hands the final gather: its level, the scene's size, where
+/// each surface's samples start, what they reflect (rho H), the share of their first bounce
+/// that came from emitting surfaces, their power weights, and which surfaces hold unshot light
+/// or emit.
+struct FirstGather {
+    int level;
+    double scale;
+    const std::vector<int>& first;
+    const std::vector<Rgb>& reflected;
+    const std::vector<Rgb>& lights;
+    const std::vector<double>& weight;
+    const std::vector<bool>& has_unshot;
+    const std::vector<bool>& emits;
+};
+
 /// The final gather (ambient_gather.h): the surfaces whose gathered radiosity reaches
 /// `threshold` gather once more at their final_gather_level, one bounce from U + R (R the
 /// converged gather's fields), and out's fields and power are replaced by theirs.
 void final_gather(const Scene& scene, const Octree& octree, const AmbientSources& sources,
-                  int level, double threshold, std::uint64_t seed,
-                  const std::vector<Rgb>& reflected, const std::vector<double>& weight,
-                  const std::vector<Rgb>& first_lights, const std::vector<int>& first,
-                  int rays_asked, AmbientGather* out) {
+                  const FirstGather& g, double threshold, std::uint64_t seed, int rays_asked,
+                  AmbientGather* out) {
     const int n = static_cast<int>(scene.surfaces.size());
-    const Box3 box = octree.bounds();
-    const double scale = box.empty() ? 1.0 : length(box.extent());
+    const int level = g.level;
+    const double scale = g.scale;
+    const std::vector<int>& first = g.first;
+    const std::vector<Rgb>& reflected = g.reflected;
     // R_j, what the converged gather makes every surface send, and which surfaces refine.
     std::vector<PolynomialPatches> sent(n);
-    std::vector<bool> sends(n, false), has_unshot(n), emits(n);
+    std::vector<bool> sends(n, false);
     std::vector<int> final_level(n, -1);
     for (int j = 0; j < n; ++j) {
-        has_unshot[j] = nonzero(sources.unshot[j]);
-        emits[j] = scene.material_of(j).emits();
         double largest = 0;
         for (int item = first[j]; item < first[j + 1]; ++item)
             largest = std::max(largest, max_abs(reflected[item]));
@@ -163,10 +193,10 @@ void final_gather(const Scene& scene, const Octree& octree, const AmbientSources
     for (int i = 0; i < n; ++i) {
         if (final_level[i] < 0) continue;
         for (int item = first[i]; item < first[i + 1]; ++item)
-            has_lights[i] = has_lights[i] || max_abs(first_lights[item]) > 0;
+            has_lights[i] = has_lights[i] || max_abs(g.lights[item]) > 0;
         if (has_lights[i])
             lights[i] = PolynomialPatches(l2_projection_of_samples(
-                sources.order[i], level, sources.order[i], &first_lights[first[i]]));
+                sources.order[i], level, sources.order[i], &g.lights[first[i]]));
     }
     std::vector<int> start(n + 1, 0);
     for (int i = 0; i < n; ++i) {
@@ -184,13 +214,10 @@ void final_gather(const Scene& scene, const Octree& octree, const AmbientSources
     std::vector<double> power(n_samples, 0.0);  // Gauss weight x A x rho H, summed
     std::vector<std::uint8_t> gathers(n_samples, 0);
     parallel_for(n_samples, [&](int item) {
-        const int i = surface_of(item), l = final_level[i];
-        const int m = sources.order[i], k = item - start[i], side = sample_side(m, l);
-        const int cells = 1 << l, S = k / side, T = k % side, a = S % m, b = T % m;
-        const GaussLegendre rule = gauss_legendre(m);
-        const double s = projection_sample_coordinate(rule, S, l);
-        const double t = projection_sample_coordinate(rule, T, l);
+        const int i = surface_of(item), k = item - start[i];
         const Surface& surface = scene.surfaces[i].surface;
+        const GatherSample at = gather_sample(surface, sources.order[i], final_level[i], k);
+        const double s = at.s, t = at.t;
         const std::optional<GatherOrigin> o = gather_origin(
             surface, i < int(sources.hidden.size()) ? &sources.hidden[i] : nullptr, s, t, scale,
             hash_seed(seed ^ 0x66696e616cULL, std::uint64_t(i), std::uint64_t(k)));
@@ -199,7 +226,7 @@ void final_gather(const Scene& scene, const Octree& octree, const AmbientSources
         for (int r = 0; r < rays; ++r) {
             const std::optional<RayHit> h = gather_ray(octree, *o, r, rays);
             if (!h) continue;
-            if (has_unshot[h->surface] && !emits[h->surface])
+            if (g.has_unshot[h->surface] && !g.emits[h->surface])
                 sum += sources.unshot[h->surface].evaluate(h->u, h->v);
             if (sends[h->surface]) sum += sent[h->surface](h->u, h->v);
         }
@@ -207,8 +234,7 @@ void final_gather(const Scene& scene, const Octree& octree, const AmbientSources
         const Rgb rho = scene.material_of(i).reflectance.value(s, t);
         const Rgb rhoH = rho * H;
         values[item] = sources.irradiance[i] ? H : rhoH;
-        power[item] = 0.25 * rule.w[a] * rule.w[b] / (double(cells) * cells) *
-                      surface.area_factor(s, t) * (rhoH.r + rhoH.g + rhoH.b);
+        power[item] = at.weight * (rhoH.r + rhoH.g + rhoH.b);
         gathers[item] = 1;
     });
     for (int i = 0; i < n; ++i) {
@@ -216,7 +242,7 @@ void final_gather(const Scene& scene, const Octree& octree, const AmbientSources
         // What the first gather added on i leaves the power, the final gather's enters it.
         for (int item = first[i]; item < first[i + 1]; ++item)
             out->power -=
-                weight[item] * (reflected[item].r + reflected[item].g + reflected[item].b);
+                g.weight[item] * (reflected[item].r + reflected[item].g + reflected[item].b);
         for (int item = start[i]; item < start[i + 1]; ++item) {
             out->power += power[item];
             out->rays += gathers[item] ? rays : 0;
@@ -262,16 +288,12 @@ AmbientGather gather_ambient(const Scene& scene, const Octree& octree,
     // The rays, cast once: work items are samples, each with its own slots, so every sum below
     // runs in a fixed order for any thread count.
     parallel_for(n_samples, [&](int item) {
-        const int i = surface_of(item);
-        const int m = sources.order[i], k = item - first[i], side = sample_side(m, level);
-        const int cells = 1 << level, S = k / side, T = k % side, a = S % m, b = T % m;
+        const int i = surface_of(item), k = item - first[i];
         const Material& material = scene.material_of(i);
-        const GaussLegendre rule = gauss_legendre(m);
-        const double s = projection_sample_coordinate(rule, S, level);
-        const double t = projection_sample_coordinate(rule, T, level);
         const Surface& surface = scene.surfaces[i].surface;
-        weight[item] =
-            0.25 * rule.w[a] * rule.w[b] / (double(cells) * cells) * surface.area_factor(s, t);
+        const GatherSample at = gather_sample(surface, sources.order[i], level, k);
+        const double s = at.s, t = at.t;
+        weight[item] = at.weight;
         rho[item] = material.reflectance.value(s, t);
         if (max_abs(material.reflectance.maximum()) == 0) return;  // reflects nothing
         const std::optional<GatherOrigin> o = gather_origin(
@@ -349,8 +371,10 @@ AmbientGather gather_ambient(const Scene& scene, const Octree& octree,
                                                     &samples[first[i]]);
     }
     if (final_threshold > 0)
-        final_gather(scene, octree, sources, level, final_threshold, seed, reflected, weight,
-                     first_lights, first, rays_asked, &out);
+        final_gather(
+            scene, octree, sources,
+            FirstGather{level, scale, first, reflected, first_lights, weight, has_unshot, emits},
+            final_threshold, seed, rays_asked, &out);
     return out;
 }
 

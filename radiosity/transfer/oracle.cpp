@@ -50,12 +50,22 @@ Rgb cell_mean(IncrementSampler& sampler, const Rect& r, const GaussLegendre& rul
     return sum;
 }
 
-/// The oracle's tolerance for values of the given magnitude. DESIGN: relative agreement, with a
-/// floor at 1% of the largest value in the domain so that nearly dark cells do not split
-/// forever, and never below the scene's absolute tolerance (its oracle_share).
+/// The oracle's relative tolerance for values of the given magnitude. DESIGN: relative
+/// agreement, with a floor at 1% of the largest value in the domain so that nearly dark cells
+/// do not split forever.
+double relative_tolerance(const Oracle& o, double magnitude) {
+    return o.opt.oracle_tolerance * std::max(magnitude, 0.01 * o.scale);
+}
+
+/// The oracle's absolute floor: the scene's absolute tolerance (its oracle_share).
+double oracle_floor(const Oracle& o) {
+    return oracle_share * o.opt.absolute_tolerance;
+}
+
+/// The oracle's tolerance for values of the given magnitude: the relative one, never below the
+/// floor.
 double oracle_tolerance(const Oracle& o, double magnitude) {
-    return std::max(o.opt.oracle_tolerance * std::max(magnitude, 0.01 * o.scale),
-                    oracle_share * o.opt.absolute_tolerance);
+    return std::max(relative_tolerance(o, magnitude), oracle_floor(o));
 }
 
 /// The samples of dB that every oracle test reads on one cell: the m x m and ceil(m/2)^2
@@ -124,13 +134,11 @@ bool interpolation_agrees(const Oracle& o, const CellSamples& c, double tol) {
 /// same shadow add up (cube.mgf: +25 % at the foot of a penumbra after 100 shots). The fit
 /// bounds a coarse cell's error by fit_share absolute tolerances at every sample instead.
 bool hybrid_agrees(const Oracle& o, const CellSamples& c) {
-    const double magnitude = max_abs(rule_mean(o.rule_m, c.f_m));
-    const double relative = o.opt.oracle_tolerance * std::max(magnitude, 0.01 * o.scale);
-    const double floor = oracle_share * o.opt.absolute_tolerance;
-    if (relative >= floor) return two_means_agree(o, c);
-    return interpolation_agrees(
-        o, c,
-        std::max(o.opt.oracle_tolerance * std::max(c.largest, 0.01 * o.scale), fit_share * floor));
+    const double floor = oracle_floor(o);
+    if (relative_tolerance(o, max_abs(rule_mean(o.rule_m, c.f_m))) >= floor)
+        return two_means_agree(o, c);
+    return interpolation_agrees(o, c,
+                                std::max(relative_tolerance(o, c.largest), fit_share * floor));
 }
 
 /// Whether the cell passes the given test ("nearly sufficient").
