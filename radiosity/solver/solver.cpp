@@ -384,6 +384,10 @@ ProgressiveSolver::ProgressiveSolver(const Scene& scene, const Octree& octree,
     shot_power_.assign(n, Rgb{});
     last_seconds_.assign(n, 0.0);
     weights_.resize(n);
+    // DESIGN: exact visibility projects each convex solid of the scene's polygons (a block, a
+    // table top) as one silhouette instead of face by face (convex_solids.h; docs/method.md).
+    if (options.receiver.shadows.method == ShadowMethod::Exact)
+        solids_ = std::make_unique<ConvexSolids>(find_convex_solids(octree.polygons()));
     hidden_.resize(n);
     if (options.hidden_regions)
         for (int i = 0; i < n; ++i) {
@@ -540,6 +544,7 @@ OcclusionContext ProgressiveSolver::occlusion_of(int h, int i, int shot) const {
                     c.end());
             group_surface_boxes(ctx);
         }
+        if (solids_) attach_solids(ctx, *solids_);
         return ctx;
     }
     // DESIGN: the candidates depend on the two surfaces only, the seed on the shot too: the

@@ -31,6 +31,7 @@
 #include "radiosity/solver/ambient_gather.h"
 #include "radiosity/solver/limiter.h"
 #include "radiosity/transfer/transfer.h"
+#include "radiosity/visibility/convex_solids.h"
 #include "radiosity/visibility/hidden_regions.h"
 
 namespace mbr {
@@ -220,6 +221,8 @@ private:
     /// the pair's first transfer for its later ones: they depend on the two surfaces only.
     /// Bounded by max_cached_candidates ints in all (beyond, a pair's are found every time).
     std::map<std::pair<int, int>, OcclusionContext> candidates_;
+    /// The scene's convex solids (exact visibility only; the contexts point into it).
+    std::unique_ptr<const ConvexSolids> solids_;
     size_t cached_candidates_ = 0;
     /// The occlusion context of shooter h -> receiver i in shot `shot` (none without shadows).
     OcclusionContext occlusion_of(int h, int i, int shot) const;

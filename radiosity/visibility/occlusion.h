@@ -13,6 +13,8 @@
 
 namespace mbr {
 
+struct ConvexSolids;
+
 /// The occluders of one shooter -> receiver pair: the polygons (of an octree over the scene)
 /// that meet the convex hull of the two surfaces, other than the two surfaces' own.
 struct OcclusionContext {
@@ -24,6 +26,12 @@ struct OcclusionContext {
     /// box is clear: shaft_clear in compute_fraction).
     std::vector<Box3> surface_boxes;
     std::uint64_t seed = 0;  // of every ray of the transfer: the pair and the shot number
+    /// The scene's convex solids (convex_solids.h; null: the candidates are loose polygons).
+    /// With them the candidates are split (attach_solids) into whole solids, solid_ids
+    /// (indices into solids->solids), and the loose polygons (increasing).
+    const ConvexSolids* solids = nullptr;
+    std::vector<int> solid_ids;
+    std::vector<int> loose;
     /// True when nothing can come between the two surfaces.
     bool clear() const { return candidates.empty(); }
 };

@@ -170,6 +170,53 @@ HorizonSides horizon_sides(const BlockedView& view, const Vec2* points, size_t n
     return sides;
 }
 
+/// The top of the slab an occluder is cut to, seen from p at height h_p > 0 above the shooter's
+/// plane. DESIGN: occluder points within 1e-7 h_p of p's height are cut off: they could only
+/// block rays grazing the shooter's plane, and would project 1e7 times further out.
+double slab_top(double h_p) {
+    return h_p * (1 - 1e-7);
+}
+
+/// Appends the points where the edge a -> b (heights ha, hb above the shooter's plane) crosses
+/// the slab 0 <= h <= h_max strictly inside the edge, in order along it (Sutherland-Hodgman
+/// against two planes at once: the parameter range of the edge inside the slab).
+void push_slab_crossings(Vec3 a, Vec3 b, double ha, double hb, double h_max,
+                         std::vector<Vec3>& out) {
+    double t0 = 0, t1 = 1;
+    const double dh = hb - ha;
+    if (dh != 0) {
+        double ta = (0 - ha) / dh, tb = (h_max - ha) / dh;
+        if (ta > tb) std::swap(ta, tb);
+        t0 = std::max(t0, ta);
+        t1 = std::min(t1, tb);
+    } else if (!(ha >= 0 && ha <= h_max)) {
+        return;
+    }
+    if (t0 > t1) return;
+    if (t0 > 0 && t0 < 1) out.push_back(a + t0 * (b - a));
+    if (t1 < 1 && t1 > t0 && t1 > 0) out.push_back(a + t1 * (b - a));
+}
+
+/// The central projection from p (at height h_p above the shooter's plane) of a point x of the
+/// slab onto the plane, x -> p + h_p / (h_p - h(x)) (x - p), in the plane's frame.
+Vec2 project_from(const ShooterPlane& plane, Vec3 p, double h_p, Vec3 x) {
+    const double h = dot(plane.normal, x - plane.origin);
+    return plane.to_plane(p + (h_p / (h_p - h)) * (x - p));
+}
+
+/// A shadow clipped to the shooter's outline, or nothing when only a sliver is left.
+/// DESIGN: a sliver at most 1e-10 of the shooter's size wide (or a speck 1e-7 of it across)
+/// is dropped (is_sliver): an occluder touching the shooter along its outline (a neighbouring
+/// face) leaves one of no area, whose nearly coincident vertices give edge lines pointing
+/// anywhere (see blocked_view). Its width, not its area against the shooter's: seen from a
+/// point close to a large shooter, a shadow small beside the shooter can hide most of what the
+/// point sees.
+ConvexPolygon clip_to_shooter(const ShooterPlane& plane, const ConvexPolygon& shadow) {
+    ConvexPolygon clipped = intersect(shadow, plane.outline);
+    if (is_sliver(clipped, 1e-10 * plane.size, 1e-7 * plane.size)) return {};
+    return clipped;
+}
+
 /// The central projection from p (at height h_p > 0 above the shooter's plane) of the part of
 /// an occluder strictly between the plane and p, x -> p + h_p / (h_p - h(x)) (x - p), clipped
 /// to the shooter's outline, counter-clockwise; empty when it hides nothing.
@@ -178,57 +225,70 @@ ConvexPolygon project_occluder(const ShooterPlane& plane, Vec3 p, double h_p,
     // Keep the part of the occluder strictly between the plane and p (0 <= h < h_p), then
     // project it from p.
     const int n = static_cast<int>(vs.size());
-    // DESIGN: occluder points within 1e-7 h_p of p's height are cut off: they could only
-    // block rays grazing the shooter's plane, and would project 1e7 times further out.
-    const double h_max = h_p * (1 - 1e-7);
+    const double h_max = slab_top(h_p);
     std::vector<Vec3> slab;
     slab.reserve(n + 4);
     for (int i = 0; i < n; ++i) {
         const Vec3 a = vs[i], b = vs[(i + 1) % n];
         const double ha = dot(plane.normal, a - plane.origin);
         const double hb = dot(plane.normal, b - plane.origin);
-        // Clip the edge to 0 <= h <= h_max (Sutherland-Hodgman against two planes at once:
-        // parameter range of the edge inside the slab).
-        auto inside = [&](double h) { return h >= 0 && h <= h_max; };
-        if (inside(ha)) slab.push_back(a);
-        double t0 = 0, t1 = 1;
-        const double dh = hb - ha;
-        if (dh != 0) {
-            double ta = (0 - ha) / dh, tb = (h_max - ha) / dh;
-            if (ta > tb) std::swap(ta, tb);
-            t0 = std::max(t0, ta);
-            t1 = std::min(t1, tb);
-        } else if (!inside(ha)) {
-            continue;
-        }
-        if (t0 > t1) continue;
-        // Entry and exit points strictly inside the edge.
-        if (t0 > 0 && t0 < 1) slab.push_back(a + t0 * (b - a));
-        if (t1 < 1 && t1 > t0 && t1 > 0) slab.push_back(a + t1 * (b - a));
+        if (ha >= 0 && ha <= h_max) slab.push_back(a);
+        push_slab_crossings(a, b, ha, hb, h_max, slab);
     }
     if (slab.size() < 3) return {};
     ConvexPolygon shadow;
     shadow.reserve(slab.size());
-    for (const Vec3& x : slab) {
-        const double h = dot(plane.normal, x - plane.origin);
-        const Vec3 X = p + (h_p / (h_p - h)) * (x - p);
-        shadow.push_back(plane.to_plane(X));
-    }
+    for (const Vec3& x : slab) shadow.push_back(project_from(plane, p, h_p, x));
     const double area = signed_area(shadow);
     if (area < 0) std::reverse(shadow.begin(), shadow.end());
     if (std::fabs(area) <= 0) return {};  // an occluder seen edge-on hides nothing
-    shadow = intersect(shadow, plane.outline);
-    // DESIGN: a sliver at most 1e-10 of the shooter's size wide (or a speck 1e-7 of it
-    // across) is dropped (is_sliver): an occluder touching the shooter along its outline
-    // (a neighbouring face) leaves one of no area, whose nearly coincident vertices give
-    // edge lines pointing anywhere (see blocked_view). Its width, not its area against the
-    // shooter's: seen from a point close to a large shooter, a shadow small beside the
-    // shooter can hide most of what the point sees.
-    if (is_sliver(shadow, 1e-10 * plane.size, 1e-7 * plane.size)) return {};
-    return shadow;
+    return clip_to_shooter(plane, shadow);
 }
 
 }  // namespace
+
+std::optional<ConvexPolygon> solid_shadow(const ShooterPlane& plane, Vec3 p, double h_p,
+                                          const ConvexSolid& solid) {
+    // The rule of convex_solids.h holds when p lies outside K by more than 1e-6 of the longest
+    // ray to the shooter: a ray entering K within 1e-7 h_p below p's height (where the faces
+    // are cut off) would then have to run 1e7 times that margin before reaching the shooter.
+    double reach = 0;
+    for (const Vec2& c : plane.outline) reach = std::max(reach, length(plane.to_space(c) - p));
+    double outside = solid.open ? solid.missing.signed_distance(p) : -HUGE_VAL;
+    for (const Plane& face : solid.faces) outside = std::max(outside, face.signed_distance(p));
+    if (!(outside > 1e-6 * reach)) return std::nullopt;
+    const double h_max = slab_top(h_p);
+    std::vector<double> h(solid.vertices.size());
+    double lowest = HUGE_VAL, highest = -HUGE_VAL;
+    for (size_t k = 0; k < h.size(); ++k) {
+        h[k] = dot(plane.normal, solid.vertices[k] - plane.origin);
+        lowest = std::min(lowest, h[k]);
+        highest = std::max(highest, h[k]);
+    }
+    if (highest < 0 || lowest > h_max) return ConvexPolygon{};  // wholly outside the slab
+    // A missing face that p sees, on a solid that reaches the shooter's plane: a ray entering
+    // through it and ending on the shooter inside K crosses no face, unless that face lies in
+    // the shooter's plane itself (a block standing on its shooter).
+    if (solid.open && solid.missing.signed_distance(p) > 0) {
+        const double tol = 1e-9 * (plane.size + solid.diameter);
+        if (lowest <= tol)
+            for (int k : solid.missing_outline)
+                if (std::fabs(h[size_t(k)]) > tol) return std::nullopt;
+    }
+    std::vector<Vec3> slab;
+    for (size_t k = 0; k < h.size(); ++k)
+        if (h[k] >= 0 && h[k] <= h_max) slab.push_back(solid.vertices[k]);
+    for (const std::array<int, 2>& e : solid.edges)
+        push_slab_crossings(solid.vertices[size_t(e[0])], solid.vertices[size_t(e[1])],
+                            h[size_t(e[0])], h[size_t(e[1])], h_max, slab);
+    if (slab.size() < 3) return ConvexPolygon{};
+    std::vector<Vec2> projected;
+    projected.reserve(slab.size());
+    for (const Vec3& x : slab) projected.push_back(project_from(plane, p, h_p, x));
+    const ConvexPolygon hull = convex_hull(std::move(projected));
+    if (hull.empty()) return hull;  // seen edge-on: it hides nothing
+    return clip_to_shooter(plane, hull);
+}
 
 BlockedView blocked_view(const ShooterPlane& plane, Vec3 p, Vec3 n_p,
                          const OcclusionContext* context, const Plane* receiver_plane) {
@@ -279,9 +339,27 @@ BlockedView blocked_view(const ShooterPlane& plane, Vec3 p, Vec3 n_p,
         }
         occluders = &near_p;
     }
-    for (int id : *occluders) {
-        ConvexPolygon shadow = project_occluder(plane, p, h_p, polys[id].vertices());
+    auto add_shadow = [&view](ConvexPolygon shadow) {
         if (!shadow.empty()) view.shadows.push_back(std::move(shadow));
+    };
+    auto add_face = [&](int id) {
+        add_shadow(project_occluder(plane, p, h_p, polys[size_t(id)].vertices()));
+    };
+    if (context->solids && occluders == &context->candidates) {
+        // Each convex solid by its silhouette (convex_solids.h), or where its rule does not
+        // hold at p, by those of its faces that are candidates.
+        for (int s : context->solid_ids) {
+            const ConvexSolid& solid = context->solids->solids[size_t(s)];
+            if (std::optional<ConvexPolygon> shadow = solid_shadow(plane, p, h_p, solid)) {
+                add_shadow(std::move(*shadow));
+                continue;
+            }
+            for (int id : solid.polygons)
+                if (std::binary_search(occluders->begin(), occluders->end(), id)) add_face(id);
+        }
+        for (int id : context->loose) add_face(id);
+    } else {
+        for (int id : *occluders) add_face(id);
     }
     merge_shadows(view.shadows);
     // DESIGN: vertices within 1e-10 of the shooter's size of the line through their neighbours

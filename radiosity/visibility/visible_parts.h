@@ -25,6 +25,7 @@
 #include "math/convex2d.h"
 #include "octree/octree.h"
 #include "radiosity/geometry/surface.h"
+#include "radiosity/visibility/convex_solids.h"
 #include "radiosity/visibility/occlusion.h"
 
 namespace mbr {
@@ -94,6 +95,16 @@ std::vector<int> occluders_toward(const OcclusionContext& context, const Shooter
 /// same line for every point of the receiver, to the last bit.
 BlockedView blocked_view(const ShooterPlane& plane, Vec3 p, Vec3 n_p,
                          const OcclusionContext* context, const Plane* receiver_plane = nullptr);
+
+/// The shadow of a convex solid (convex_solids.h) on a planar shooter seen from p, at height
+/// h_p > 0 above its plane: the convex hull of the central projections of its corners and of
+/// its edges' crossings with the slab that each face is cut to (as blocked_view cuts them),
+/// clipped to the shooter's outline; empty when it hides nothing. Nothing (std::nullopt) where
+/// the solid's rule does not hold at p: p within 1e-6 of the longest ray's length of the solid,
+/// or a missing face that p sees on a solid reaching the shooter's plane (then the faces are
+/// projected one by one).
+std::optional<ConvexPolygon> solid_shadow(const ShooterPlane& plane, Vec3 p, double h_p,
+                                          const ConvexSolid& solid);
 
 /// The plane of a planar quad (Newell's normal through the corners' mean; only when its corners
 /// lie on it to rounding) or a disk, oriented by its front; nothing for other surfaces.

@@ -1,0 +1,57 @@
+// radiosity/visibility/convex_solids.h - occluders that are faces of one convex solid (a block of
+// the Cornell box, a table top, a tessellated ball), found once per scene, and their silhouette
+// seen from a receiving point: the shadow of the whole solid on a planar shooter's plane in one
+// convex hull, instead of one projection per face and pairwise merges (paper section 6,
+// "Shadow", with exact visibility; issue 20, "one silhouette per occluder").
+//
+// A solid here is a set of polygons, connected through shared edges (the same two vertices, to
+// the bit), that bounds a convex polyhedron K: every vertex lies behind every face's plane (the
+// faces look outward), each edge belongs to two faces, except the edges of at most one missing
+// face (a block standing on the floor has no bottom), which lie in one plane that supports K.
+// Seen from a point p outside K, every ray through K crosses a face of the set, unless it enters
+// through the missing face and ends inside K (checked per point: solid_shadow), so the union of
+// the faces' shadows is the shadow of K: the convex hull of the projected corners of K cut to the
+// slab between the shooter's plane and p (solid_shadow, radiosity/visibility/visible_parts.h).
+#pragma once
+
+#include <array>
+#include <vector>
+
+#include "octree/polygon.h"
+
+namespace mbr {
+
+struct OcclusionContext;
+
+/// One convex solid of a scene's polygons.
+struct ConvexSolid {
+    std::vector<int> polygons;         // polygon indices, increasing
+    std::vector<Vec3> vertices;        // its corners (each once)
+    std::vector<std::array<int, 2>> edges;  // vertex index pairs, each edge once
+    std::vector<Plane> faces;          // the planes of its polygons, facing outward
+    bool open = false;                 // one face is missing (not in the scene)
+    Plane missing;                     // its plane, facing outward (when open)
+    std::vector<int> missing_outline;  // the vertices on the missing face's outline
+    double diameter = 0;               // of its bounding box
+};
+
+/// The convex solids of a scene's polygons, and for each polygon its solid.
+struct ConvexSolids {
+    std::vector<ConvexSolid> solids;
+    std::vector<int> solid_of;  // per polygon: the index of its solid, or -1
+};
+
+/// Solids with more faces than this are not looked for (their silhouettes cost more than the
+/// faces' projections would save, and exact visibility projects at most exact_limit occluders).
+constexpr int max_solid_faces = 64;
+
+/// The convex solids among `polygons` (linear in their number: vertices matched by their bits).
+ConvexSolids find_convex_solids(const std::vector<Polygon>& polygons);
+
+/// Splits a pair's occluder candidates between whole solids and loose polygons: a solid with at
+/// least one candidate face and no face on the pair's own two surfaces stands for all its faces
+/// (a face of it that is no candidate cannot come between the pair: its shadow from a point of
+/// the receiver misses the shooter). Sets context.solids, context.solid_ids and context.loose.
+void attach_solids(OcclusionContext& context, const ConvexSolids& solids);
+
+}  // namespace mbr

@@ -1,0 +1,223 @@
+// test/test_convex_solids.cpp - convex solids among a scene's polygons and their silhouettes
+// (radiosity/visibility/convex_solids.h, solid_shadow in visible_parts.h): which face sets are
+// solids, and that a solid's silhouette is the union of its faces' shadows wherever its rule
+// holds (against the faces projected one by one and merged, as blocked_view did before).
+#include <algorithm>
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "radiosity/visibility/convex_solids.h"
+#include "radiosity/visibility/occlusion.h"
+#include "radiosity/visibility/visible_parts.h"
+
+using namespace mbr;
+
+namespace {
+
+std::vector<Vec2> no_uv(size_t n) {
+    return std::vector<Vec2>(n, Vec2{0, 0});
+}
+
+/// The faces of the box [lo, hi] (outward, counter-clockwise from outside), bottom (y = lo.y)
+/// last, each its own surface from `first_surface`.
+std::vector<Polygon> box_faces(Vec3 lo, Vec3 hi, int first_surface, bool with_bottom) {
+    const Vec3 c[8] = {{lo.x, lo.y, lo.z}, {hi.x, lo.y, lo.z}, {hi.x, lo.y, hi.z},
+                       {lo.x, lo.y, hi.z}, {lo.x, hi.y, lo.z}, {hi.x, hi.y, lo.z},
+                       {hi.x, hi.y, hi.z}, {lo.x, hi.y, hi.z}};
+    const int faces[6][4] = {{4, 7, 6, 5},   // top (+y)
+                             {0, 4, 5, 1},   // -z
+                             {1, 5, 6, 2},   // +x
+                             {2, 6, 7, 3},   // +z
+                             {3, 7, 4, 0},   // -x
+                             {0, 1, 2, 3}};  // bottom (-y)
+    std::vector<Polygon> out;
+    for (int f = 0; f < (with_bottom ? 6 : 5); ++f) {
+        std::vector<Vec3> v;
+        for (int k : faces[f]) v.push_back(c[k]);
+        out.emplace_back(v, no_uv(4), first_surface + f);
+    }
+    return out;
+}
+
+/// The shadows of the faces one by one, merged (the face-by-face path of blocked_view).
+std::vector<ConvexPolygon> face_shadows(const ShooterPlane& plane, Vec3 p,
+                                        const std::vector<Polygon>& faces) {
+    OcclusionContext ctx;
+    Octree octree(faces);
+    ctx.octree = &octree;
+    ctx.shooter_surface = ctx.receiver_surface = -1;
+    for (int i = 0; i < int(faces.size()); ++i) ctx.candidates.push_back(i);
+    return blocked_view(plane, p, -1.0 * plane.normal, &ctx).shadows;  // p faces the shooter
+}
+
+/// The area of the union of convex polygons: each minus the ones before it, in pieces.
+double union_area(const std::vector<ConvexPolygon>& shadows) {
+    double a = 0;
+    for (size_t s = 0; s < shadows.size(); ++s) {
+        std::vector<ConvexPolygon> parts{shadows[s]};
+        for (size_t t = 0; t < s; ++t) {
+            std::vector<ConvexPolygon> next;
+            for (const ConvexPolygon& part : parts)
+                for (ConvexPolygon& rest : subtract(part, shadows[t])) next.push_back(rest);
+            parts = std::move(next);
+        }
+        for (const ConvexPolygon& part : parts) a += signed_area(part);
+    }
+    return a;
+}
+
+}  // namespace
+
+TEST_CASE("convex solids: which sets of faces bound a convex solid", "[shadow][convex_solids]") {
+    SECTION("a box without its bottom: one open solid, its missing face the bottom") {
+        const std::vector<Polygon> faces = box_faces({0, 0, 0}, {1, 2, 3}, 0, false);
+        const ConvexSolids s = find_convex_solids(faces);
+        REQUIRE(s.solids.size() == 1);
+        const ConvexSolid& solid = s.solids[0];
+        CHECK(solid.open);
+        CHECK(solid.polygons == std::vector<int>{0, 1, 2, 3, 4});
+        CHECK(solid.vertices.size() == 8);
+        CHECK(solid.edges.size() == 12);
+        CHECK(solid.missing_outline.size() == 4);
+        CHECK(solid.missing.normal.y == Approx(-1));
+        CHECK(solid.missing.offset == Approx(0).margin(1e-12));
+        CHECK(std::count(s.solid_of.begin(), s.solid_of.end(), 0) == 5);
+    }
+    SECTION("a closed box") {
+        const ConvexSolids s = find_convex_solids(box_faces({0, 0, 0}, {1, 1, 1}, 0, true));
+        REQUIRE(s.solids.size() == 1);
+        CHECK_FALSE(s.solids[0].open);
+        CHECK(s.solids[0].faces.size() == 6);
+    }
+    SECTION("two boxes apart and a loose quad") {
+        std::vector<Polygon> faces = box_faces({0, 0, 0}, {1, 1, 1}, 0, true);
+        for (Polygon& p : box_faces({3, 0, 0}, {4, 1, 1}, 6, false)) faces.push_back(p);
+        faces.emplace_back(std::vector<Vec3>{{0, 5, 0}, {1, 5, 0}, {1, 5, 1}, {0, 5, 1}},
+                           no_uv(4), 11);
+        const ConvexSolids s = find_convex_solids(faces);
+        REQUIRE(s.solids.size() == 2);
+        CHECK(s.solid_of[3] == 0);
+        CHECK(s.solid_of[7] == 1);
+        CHECK(s.solid_of[11] == -1);
+    }
+    SECTION("not solids: faces looking inward, two faces only, two missing faces, an L") {
+        std::vector<Polygon> inward;
+        for (const Polygon& p : box_faces({0, 0, 0}, {1, 1, 1}, 0, true)) {
+            std::vector<Vec3> v = p.vertices();
+            std::reverse(v.begin(), v.end());
+            inward.emplace_back(v, no_uv(4), p.surface());
+        }
+        CHECK(find_convex_solids(inward).solids.empty());
+        std::vector<Polygon> two = box_faces({0, 0, 0}, {1, 1, 1}, 0, false);
+        two.erase(two.begin() + 2, two.end());
+        CHECK(find_convex_solids(two).solids.empty());
+        std::vector<Polygon> tube = box_faces({0, 0, 0}, {1, 1, 1}, 0, false);
+        tube.erase(tube.begin());  // top and bottom missing: a tube
+        CHECK(find_convex_solids(tube).solids.empty());
+        // Two boxes glued along an edge of their tops: connected, not convex.
+        std::vector<Polygon> l = box_faces({0, 0, 0}, {1, 1, 1}, 0, false);
+        std::vector<Polygon> other = box_faces({1, 0, 0}, {2, 2, 1}, 5, false);
+        l.insert(l.end(), other.begin(), other.end());
+        for (const ConvexSolid& solid : find_convex_solids(l).solids)
+            CHECK(solid.polygons.size() == 5);  // each box alone, never the two together
+    }
+}
+
+TEST_CASE("convex solids: a solid's silhouette is the union of its faces' shadows",
+          "[shadow][convex_solids]") {
+    // A block standing on the floor (no bottom) and a floating closed box, seen from random
+    // points in front of three shooters: the floor the block stands on (its missing face in the
+    // shooter's plane), a wall beside it and the ceiling (points below the block's top cut it).
+    const std::vector<Polygon> block = box_faces({2, 0, 2}, {3, 1.5, 3.2}, 0, false);
+    const std::vector<Polygon> floating = box_faces({1, 1, 1}, {1.6, 1.4, 1.5}, 0, true);
+    const Surface shooters[] = {
+        Surface::planar_quad({0, 0, 0}, {0, 0, 5}, {5, 0, 5}, {5, 0, 0}),  // floor, facing up
+        Surface::planar_quad({5, 0, 0}, {5, 0, 5}, {5, 3, 5}, {5, 3, 0}),  // wall x = 5
+        Surface::planar_quad({0, 3, 0}, {5, 3, 0}, {5, 3, 5}, {0, 3, 5}),  // ceiling, down
+    };
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<double> u(0.05, 4.95), v(0.02, 2.95);
+    int compared = 0, refused = 0;
+    for (const std::vector<Polygon>* faces : {&block, &floating}) {
+        const ConvexSolids solids = find_convex_solids(*faces);
+        REQUIRE(solids.solids.size() == 1);
+        for (const Surface& shooter : shooters) {
+            const ShooterPlane plane = make_shooter_plane(shooter);
+            for (int k = 0; k < 300; ++k) {
+                const Vec3 p{u(rng), v(rng), u(rng)};
+                const double h_p = dot(plane.normal, p - plane.origin);
+                if (h_p <= 0) continue;
+                const std::optional<ConvexPolygon> silhouette =
+                    solid_shadow(plane, p, h_p, solids.solids[0]);
+                if (!silhouette) {
+                    ++refused;
+                    continue;
+                }
+                ++compared;
+                const std::vector<ConvexPolygon> merged = face_shadows(plane, p, *faces);
+                INFO("p = " << p << ", shooter normal " << plane.normal);
+                const double scale = plane.size * plane.size;
+                CHECK(signed_area(*silhouette) == Approx(union_area(merged)).margin(1e-9 * scale));
+                // Where the faces' shadows merged into one polygon, it is the silhouette.
+                if (merged.size() == 1)
+                    for (const Vec2& q : *silhouette) {
+                        bool near = contains(merged[0], q);
+                        for (const Vec2& r : merged[0])
+                            near = near || std::hypot(q.x - r.x, q.y - r.y) <= 1e-9 * plane.size;
+                        CHECK(near);
+                    }
+            }
+        }
+    }
+    CHECK(compared > 1000);
+    CHECK(refused < compared / 10);
+}
+
+TEST_CASE("convex solids: no silhouette where the rule fails", "[shadow][convex_solids]") {
+    const ShooterPlane plane = make_shooter_plane(
+        Surface::planar_quad({0, 3, 0}, {5, 3, 0}, {5, 3, 5}, {0, 3, 5}));  // ceiling, down
+    SECTION("a point on (or inside) the solid") {
+        const ConvexSolids s = find_convex_solids(box_faces({2, 0, 2}, {3, 1.5, 3}, 0, true));
+        REQUIRE(s.solids.size() == 1);
+        for (const Vec3 p : {Vec3{2.5, 1.5, 2.5}, Vec3{2.5, 1, 2.5}, Vec3{3, 1, 2.5}})
+            CHECK_FALSE(solid_shadow(plane, p, dot(plane.normal, p - plane.origin), s.solids[0]));
+    }
+    SECTION("a missing face seen from below, on a solid that reaches the shooter") {
+        // A box hanging from the ceiling, open at its bottom: from below a ray through the
+        // opening to the ceiling inside the box crosses no face.
+        const ConvexSolids s = find_convex_solids(box_faces({2, 2, 2}, {3, 3, 3}, 0, false));
+        REQUIRE(s.solids.size() == 1);
+        const Vec3 p{2.5, 0.5, 2.5};
+        CHECK_FALSE(solid_shadow(plane, p, dot(plane.normal, p - plane.origin), s.solids[0]));
+    }
+    SECTION("a solid wholly behind the shooter or above the point hides nothing") {
+        const ConvexSolids s = find_convex_solids(box_faces({2, 3.5, 2}, {3, 4, 3}, 0, true));
+        const Vec3 p{2.5, 1, 2.5};
+        const std::optional<ConvexPolygon> shadow =
+            solid_shadow(plane, p, dot(plane.normal, p - plane.origin), s.solids[0]);
+        REQUIRE(shadow);
+        CHECK(shadow->empty());
+    }
+}
+
+TEST_CASE("convex solids: a pair's candidates split into whole solids and loose polygons",
+          "[shadow][convex_solids]") {
+    std::vector<Polygon> faces = box_faces({2, 0, 2}, {3, 1, 3}, 10, false);  // surfaces 10-14
+    for (Polygon& p : box_faces({0, 0, 0}, {1, 1, 1}, 20, true)) faces.push_back(p);
+    faces.emplace_back(std::vector<Vec3>{{0, 5, 0}, {1, 5, 0}, {1, 5, 1}, {0, 5, 1}}, no_uv(4),
+                       30);
+    const Octree octree(faces);
+    const ConvexSolids solids = find_convex_solids(faces);
+    REQUIRE(solids.solids.size() == 2);
+    OcclusionContext ctx;
+    ctx.octree = &octree;
+    ctx.shooter_surface = 21;  // a face of the second box: that solid stays loose
+    ctx.receiver_surface = 99;
+    ctx.candidates = {1, 3, 6, 8, 11};
+    attach_solids(ctx, solids);
+    CHECK(ctx.solids == &solids);
+    CHECK(ctx.solid_ids == std::vector<int>{0});
+    CHECK(ctx.loose == std::vector<int>{6, 8, 11});
+}
