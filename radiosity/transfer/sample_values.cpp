@@ -138,36 +138,46 @@ Rgb IncrementIntegrator::sum_over(const SurfacePoint& p, PointSpan pts) const {
     return sum;
 }
 
-Rgb IncrementIntegrator::triangle_value(const SurfacePoint& p, Vec2 a, Vec2 b, Vec2 c, int n) {
+IncrementIntegrator::ShadowTriangleCorners IncrementIntegrator::triangle_corners(Vec2 a, Vec2 b,
+                                                                                  Vec2 c) const {
+    ShadowTriangleCorners t{a, b, c, {}, {}, {}, std::fabs(cross(b - a, c - a))};
+    if (!unshot_constant_) {  // (u, v) at the corners exactly
+        t.uv_a = plane_.parameters(a);
+        t.uv_b = plane_.parameters(b);
+        t.uv_c = plane_.parameters(c);
+    }
+    return t;
+}
+
+Rgb IncrementIntegrator::triangle_value(const SurfacePoint& p, const ShadowTriangleCorners& t,
+                                        int n) {
     // The n x n collapsed Gauss rule on one triangle of the shooter's plane:
     // int F(p, x) (B_h(u(x), v(x)) - b*) dA(x).
     const TriangleRule& rule = tri_rules_[n];
-    const double jacobian = std::fabs(cross(b - a, c - a));
     Rgb sum;
-    if (jacobian <= 0) return sum;
+    if (t.jacobian <= 0) return sum;
     const Rgb constant_b = unshot_constant_ ? shooter_.unshot.coefficient(0, 0) : Rgb{};
-    // (u, v) at the corners exactly; at a node, their affine blend refined by a Newton step
-    // (the inverse of the bilinear map is nearly affine over one triangle).
-    Vec2 uv_a, uv_b, uv_c;
-    if (!unshot_constant_) {
-        uv_a = plane_.parameters(a);
-        uv_b = plane_.parameters(b);
-        uv_c = plane_.parameters(c);
-    }
-    for (size_t q = 0; q < rule.points.size(); ++q) {
-        const double xi = rule.points[q].x, eta = rule.points[q].y;
-        const Vec2 X = a + xi * (b - a) + eta * (c - a);
+    const Vec2 ab = t.b - t.a, ac = t.c - t.a;
+    const size_t n_points = rule.points.size();
+    const Vec2* points = rule.points.data();
+    const double* weights = rule.weights.data();
+    extra_evaluations_ += long(n_points);
+    const Rgb b_star = b_star_;
+    for (size_t q = 0; q < n_points; ++q) {
+        const double xi = points[q].x, eta = points[q].y;
+        const Vec2 X = t.a + xi * ab + eta * ac;
         const double F =
             form_factor_kernel(p.position, p.normal, plane_.to_space(X), plane_.normal);
-        ++extra_evaluations_;
         if (F == 0) continue;
         Rgb B = constant_b;
         if (!unshot_constant_) {
-            const Vec2 guess = uv_a + xi * (uv_b - uv_a) + eta * (uv_c - uv_a);
+            // At a node, the corners' affine blend refined by a Newton step (the inverse of the
+            // bilinear map is nearly affine over one triangle).
+            const Vec2 guess = t.uv_a + xi * (t.uv_b - t.uv_a) + eta * (t.uv_c - t.uv_a);
             const Vec2 uv = plane_.refine_parameters(X, plane_.refine_parameters(X, guess));
             B = unshot_patches_(uv.x, uv.y);
         }
-        sum += (rule.weights[q] * jacobian * F) * (B - b_star_);
+        sum += (weights[q] * t.jacobian * F) * (B - b_star);
     }
     return sum;
 }
@@ -212,8 +222,9 @@ Rgb IncrementIntegrator::shadow_integral(const SurfacePoint& p, double tolerance
                 for (const ShadowTriangle& ch : t.children()) todo.push_back(ch);
                 continue;
             }
-            const Rgb f0 = triangle_value(p, v[0], v[1], v[2], n_tri);
-            const Rgb f1 = triangle_value(p, v[0], v[1], v[2], n_tri + 1);
+            const ShadowTriangleCorners corners = triangle_corners(v[0], v[1], v[2]);
+            const Rgb f0 = triangle_value(p, corners, n_tri);
+            const Rgb f1 = triangle_value(p, corners, n_tri + 1);
             const double error = max_abs(f1 - f0);
             total += error;
             Item item{t, f1, error};
@@ -256,7 +267,7 @@ Rgb IncrementIntegrator::shadow_on(const SurfacePoint& p,
         const Vec2 a = piece[0], b = piece[t.fan], c = piece[t.fan + 1];
         Vec2 v[3];
         for (int k = 0; k < 3; ++k) v[k] = a + t.bary[k].x * (b - a) + t.bary[k].y * (c - a);
-        sum += triangle_value(p, v[0], v[1], v[2],
+        sum += triangle_value(p, triangle_corners(v[0], v[1], v[2]),
                               (options_.n_pieces > 0 ? options_.n_pieces : options_.n) + 1);
     }
     return sum;

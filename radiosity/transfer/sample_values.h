@@ -215,7 +215,16 @@ private:
     bool too_near(const SurfacePoint& p, const QuadCell& cell, double near_field);
     ConvexPolygon cell_image(const QuadCell& cell) const;
     Rgb pieces_value(const SurfacePoint& p, const std::vector<ConvexPolygon>& pieces, int n);
-    Rgb triangle_value(const SurfacePoint& p, Vec2 a, Vec2 b, Vec2 c, int n);
+    /// A triangle of the shooter's plane, the (u, v) of its corners (unless B_h is constant)
+    /// and twice its area: what both rules of a shadow triangle share.
+    struct ShadowTriangleCorners {
+        Vec2 a, b, c;
+        Vec2 uv_a, uv_b, uv_c;
+        double jacobian;
+    };
+    ShadowTriangleCorners triangle_corners(Vec2 a, Vec2 b, Vec2 c) const;
+    /// The n x n collapsed Gauss rule of F (B_h - b*) on the triangle.
+    Rgb triangle_value(const SurfacePoint& p, const ShadowTriangleCorners& t, int n);
     /// int F (B_h - b*) over the shadowed part (shadow_regions_) to `tolerance`, adaptively
     /// over its fan triangles; the triangles kept are appended to *kept.
     Rgb shadow_integral(const SurfacePoint& p, double tolerance, double near_field,

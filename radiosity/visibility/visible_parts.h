@@ -61,7 +61,8 @@ struct ShooterPlane {
         const Vec2 pu = e + v * g, pv = f + u * g;
         const double det = cross(pu, pv);
         if (det == 0) return guess;
-        return {u - cross(r, pv) / det, v - cross(pu, r) / det};
+        const double inverse = 1 / det;
+        return {u - cross(r, pv) * inverse, v - cross(pu, r) * inverse};
     }
 };
 /// The frame of a planar quad (its corners projected onto their mean plane).
