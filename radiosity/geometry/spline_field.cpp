@@ -171,41 +171,6 @@ PolynomialPatches::PolynomialPatches(const SplineField& field) {
             }
 }
 
-namespace {
-
-/// Horner's rule in both directions on one cell's m x m x 3 coefficients (channel innermost),
-/// the three channels at once; M > 0 fixes the order at compile time (the common m = 4).
-template <int M>
-Rgb horner_cell(const double* C, int m_runtime, double lx, double ly) {
-    const int m = M > 0 ? M : m_runtime;
-    double v0 = 0, v1 = 0, v2 = 0;
-    for (int p = m - 1; p >= 0; --p) {
-        double r0 = 0, r1 = 0, r2 = 0;
-        for (int q = m - 1; q >= 0; --q) {
-            const double* c = C + (p * m + q) * 3;
-            r0 = r0 * ly + c[0];
-            r1 = r1 * ly + c[1];
-            r2 = r2 * ly + c[2];
-        }
-        v0 = v0 * lx + r0;
-        v1 = v1 * lx + r1;
-        v2 = v2 * lx + r2;
-    }
-    return {v0, v1, v2};
-}
-
-}  // namespace
-
-Rgb PolynomialPatches::operator()(double s, double t) const {
-    if (c_.empty()) return {};
-    const double x = std::clamp(s, 0.0, 1.0) * cells_, y = std::clamp(t, 0.0, 1.0) * cells_;
-    const int i = std::min(cells_ - 1, static_cast<int>(x)),
-              j = std::min(cells_ - 1, static_cast<int>(y));
-    const double lx = x - i, ly = y - j;
-    const double* C = &c_[(size_t(j) * cells_ + i) * 3 * m_ * m_];
-    return m_ == 4 ? horner_cell<4>(C, 4, lx, ly) : horner_cell<0>(C, m_, lx, ly);
-}
-
 bool SplineField::is_constant() const {
     for (const auto& g : grid_)
         for (double v : g.a)
