@@ -551,11 +551,15 @@ bool Octree::any_hit(const Ray& ray, RayStats* stats) const {
 }
 
 bool Octree::any_hit(const Ray& ray, const RayFilter& filter, RayStats* stats) const {
-    if (!has_root_) return false;
+    return any_hit_polygon(ray, filter, stats) >= 0;
+}
+
+int Octree::any_hit_polygon(const Ray& ray, const RayFilter& filter, RayStats* stats) const {
+    if (!has_root_) return -1;
     Query q(ray, filter, true);
     const bool hit = q.meets_box(grown_root_) && traverse(root_, q);
     if (stats) *stats += q.stats;
-    return hit;
+    return hit ? q.best : -1;
 }
 
 }  // namespace mbr

@@ -138,6 +138,9 @@ public:
     bool any_hit(const Ray& ray, RayStats* stats = nullptr) const;
     /// The same, skipping the polygons and hits `filter` names.
     bool any_hit(const Ray& ray, const RayFilter& filter, RayStats* stats = nullptr) const;
+    /// The same, saying which polygon it found (-1: none): for callers that test it first on
+    /// the next ray (a shadow cache).
+    int any_hit_polygon(const Ray& ray, const RayFilter& filter, RayStats* stats = nullptr) const;
     /// The polygons listed by the leaves whose grown cubes `node_may_meet` accepts (it is asked
     /// for every node on the way down, so a region query prunes whole subtrees), each once, in
     /// increasing order.

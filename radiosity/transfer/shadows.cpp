@@ -189,6 +189,7 @@ Rgb compute_fraction(const ReceiverState& state, IncrementSampler& sampler, Vec2
             boxes = ctx.surface_boxes;
         }
     }
+    RecentBlockers recent;  // the point's last blockers, tested first (same answers)
     Rgb num, den;
     for (size_t i = 0; i < partition.size(); ++i) {
         const AcceptedCell<Rgb>& patch = partition[i];
@@ -249,8 +250,10 @@ Rgb compute_fraction(const ReceiverState& state, IncrementSampler& sampler, Vec2
             }
             if (!(max_abs(w) > 0)) continue;
             weight += w;
-            const bool blocked = plane ? segment_blocked(ctx, toward, p.position, x, n_rays)
-                                       : segment_blocked(ctx, p.position, x, n_rays);
+            const bool blocked =
+                plane ? segment_blocked(ctx, toward, p.position, x, n_rays, max_listed_occluders,
+                                        &recent)
+                      : segment_blocked(ctx, p.position, x, n_rays, &recent);
             if (!blocked) visible += w;
         }
         // A channel no ray weighs (no ray ends where the patch shoots toward p) is left out.

@@ -286,28 +286,43 @@ void group_surface_boxes(OcclusionContext& context) {
     }
 }
 
-bool segment_blocked(const OcclusionContext& context, Vec3 a, Vec3 b, long* n_rays) {
+bool segment_blocked(const OcclusionContext& context, Vec3 a, Vec3 b, long* n_rays,
+                     RecentBlockers* recent) {
     if (context.candidates.empty()) return false;
     if (n_rays) ++*n_rays;
     // DESIGN: the open segment, t in [1e-9, 1 - 1e-9]: the end points lie on the two surfaces,
     // which never block their own transfer anyway (their polygons are skipped). The ends lie on
     // true surfaces, so a curved neighbour's facets near them do not block (Polygon::hit_counts).
     const Ray ray{a, b - a, 1e-9, 1 - 1e-9};
+    const std::vector<Polygon>& polys = context.octree->polygons();
+    // Polygons that blocked this point's rays before were found under the same rules (the
+    // octree's test is Polygon::intersect_segment's on a packed copy): a hit among them is one.
+    if (recent)
+        for (int id : recent->ids)
+            if (id >= 0 && polys[size_t(id)].intersect_segment(ray)) {
+                recent->note(id);
+                return true;
+            }
+    int blocker = -1;
     if (context.candidates.size() <= 16) {
-        const std::vector<Polygon>& polys = context.octree->polygons();
         for (int id : context.candidates)
-            if (polys[id].intersect_segment(ray)) return true;
-        return false;
+            if (polys[id].intersect_segment(ray)) {
+                blocker = id;
+                break;
+            }
+    } else {
+        blocker = context.octree->any_hit_polygon(
+            ray, RayFilter{context.shooter_surface, context.receiver_surface, true});
     }
-    return context.octree->any_hit(
-        ray, RayFilter{context.shooter_surface, context.receiver_surface, true});
+    if (blocker >= 0 && recent) recent->note(blocker);
+    return blocker >= 0;
 }
 
 bool segment_blocked(const OcclusionContext& context, const std::vector<int>& occluders, Vec3 a,
-                     Vec3 b, long* n_rays, size_t max_listed) {
+                     Vec3 b, long* n_rays, size_t max_listed, RecentBlockers* recent) {
     if (occluders.empty()) return false;
     // DESIGN: up to 32 occluders are tested one by one; beyond, the octree is faster.
-    if (occluders.size() > max_listed) return segment_blocked(context, a, b, n_rays);
+    if (occluders.size() > max_listed) return segment_blocked(context, a, b, n_rays, recent);
     if (n_rays) ++*n_rays;
     const Ray ray{a, b - a, 1e-9, 1 - 1e-9};
     const std::vector<Polygon>& polys = context.octree->polygons();

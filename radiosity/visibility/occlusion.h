@@ -3,6 +3,7 @@
 // casts no rays; "Shadow": the rays of eq. (28)), with the reproducible seeds of those rays.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -63,15 +64,32 @@ constexpr size_t max_listed_occluders = 32;
 /// still more, and visibility is one ray per quadrature node (BlockedView::use_rays).
 constexpr int exact_limit = 24;
 
+/// The occluders that blocked the last few segments of one receiving point (a shadow cache, as
+/// Haines and Greenberg's light buffer keeps the last occluder): tested first, since nearby
+/// rays are mostly blocked by the same polygon. Answers never depend on it.
+struct RecentBlockers {
+    std::array<int, 4> ids{{-1, -1, -1, -1}};  // most recent first
+    /// Makes `id` the most recent.
+    void note(int id) {
+        int k = 0;
+        while (k < 3 && ids[size_t(k)] != id) ++k;
+        for (; k > 0; --k) ids[size_t(k)] = ids[size_t(k - 1)];
+        ids[0] = id;
+    }
+};
+
 /// True when an occluder of the context blocks the open segment a -> b (any-hit: a loop over
 /// the candidates when they are few, else the octree with the pair's own surfaces skipped; the
-/// answer is the same). Counts the ray in *n_rays.
-bool segment_blocked(const OcclusionContext& context, Vec3 a, Vec3 b, long* n_rays);
+/// answer is the same). Counts the ray in *n_rays. With `recent`, its polygons are tested first
+/// and the blocker found is noted there.
+bool segment_blocked(const OcclusionContext& context, Vec3 a, Vec3 b, long* n_rays,
+                     RecentBlockers* recent = nullptr);
 /// The same against a subset of the candidates known to hold every polygon that can meet the
 /// segment (occluders_toward); an empty subset casts no ray. Beyond `max_listed` occluders the
 /// segment goes to the octree instead.
 bool segment_blocked(const OcclusionContext& context, const std::vector<int>& occluders, Vec3 a,
-                     Vec3 b, long* n_rays, size_t max_listed = max_listed_occluders);
+                     Vec3 b, long* n_rays, size_t max_listed = max_listed_occluders,
+                     RecentBlockers* recent = nullptr);
 /// Up to this many occluders a ray of exact visibility is tested one by one: its list holds only
 /// the polygons that meet its cell's shaft, where the octree costs several times more per ray
 /// (measured inside a sphere of 20 pieces: 4 us against 0.5 us).
