@@ -74,52 +74,74 @@ Rgb clamp_to_samples(const ReceiverState& state, Rgb v) {
 }
 }  // namespace
 
-Rgb extrapolate(const ReceiverState& state, double s, double t) {
-    const ReceiverOptions& opt = state.options;
-    const int si = s < 0 ? -1 : (s > 1 ? 1 : 0);
-    const int ti = t < 0 ? -1 : (t > 1 ? 1 : 0);
-    MBR_CHECK_MSG(si != 0 || ti != 0, "extrapolate inside the domain at " << s << ", " << t);
-    // DESIGN: derivatives are clamped so that the extrapolation changes by at most
-    // clamp_factor * max|dB| over one of the finest boundary leaves of that edge.
-    auto clamp_bound = [&](const EdgeProfile& p) {
-        return opt.clamp_factor * state.max_sample / p.h_min;
-    };
-    const bool linear = opt.extrapolation == Extrapolation::Linear;
+namespace {
+/// DESIGN: derivatives are clamped so that the extrapolation changes by at most clamp_factor *
+/// max|dB| over one of the finest boundary leaves of that edge.
+double clamp_bound(const ReceiverState& state, const EdgeProfile& p) {
+    return state.options.clamp_factor * state.max_sample / p.h_min;
+}
+}  // namespace
 
-    if (si == 0 || ti == 0) {
-        // Patches 1, 3, 5, 7: extrapolate along the edge normal, eq. (23) or (26)/(27).
-        const int e = ti < 0 ? 0 : (si > 0 ? 1 : (ti > 0 ? 2 : 3));
-        const EdgeProfile& p = state.edges[e];
-        Rgb v, d;
-        p.at((e == 0 || e == 2) ? s : t, v, d);
-        d = clamp_rgb(d, clamp_bound(p));
-        // Signed offset from the edge along its normal coordinate (t - c or s - b).
-        const double offset = e == 0 ? t : (e == 1 ? s - 1 : (e == 2 ? t - 1 : s));
-        if (linear) return clamp_to_samples(state, v + offset * d);  // eq. (23)
-        const double w = p.h_min, x = std::fabs(offset) / w;
-        const Rgb d_out = (offset < 0 ? -1.0 : 1.0) * d;  // derivative along the outward normal
-        double phi0, phi1;
-        decay_profiles(opt.extrapolation, x, phi0, phi1);
-        return phi0 * v + (w * phi1) * d_out;
-    }
-    // Patches 0, 2, 4, 6: from the corner (s_c, t_c), eqs. (24)-(25) or the tensor form.
+EdgeValue edge_value(const ReceiverState& state, int e, double sigma) {
+    const EdgeProfile& p = state.edges[e];
+    EdgeValue out;
+    p.at(sigma, out.v, out.d);
+    out.d = clamp_rgb(out.d, clamp_bound(state, p));
+    return out;
+}
+
+Rgb extrapolate_side(const ReceiverState& state, int e, const EdgeValue& at_foot, double offset) {
+    const ReceiverOptions& opt = state.options;
+    if (opt.extrapolation == Extrapolation::Linear)
+        return clamp_to_samples(state, at_foot.v + offset * at_foot.d);  // eq. (23)
+    const double w = state.edges[e].h_min, x = std::fabs(offset) / w;
+    const Rgb d_out = (offset < 0 ? -1.0 : 1.0) * at_foot.d;  // along the outward normal
+    double phi0, phi1;
+    decay_profiles(opt.extrapolation, x, phi0, phi1);
+    return phi0 * at_foot.v + (w * phi1) * d_out;
+}
+
+CornerValue corner_value(const ReceiverState& state, double s_c, double t_c) {
+    const EdgeProfile& horizontal = state.edges[t_c < 0.5 ? 0 : 2];  // carries d/dt there
+    const EdgeProfile& vertical = state.edges[s_c > 0.5 ? 1 : 3];    // carries d/ds there
+    CornerValue c;
+    Rgb v2;
+    horizontal.at(s_c, c.v, c.d_t);
+    vertical.at(t_c, v2, c.d_s);
+    c.d_t = clamp_rgb(c.d_t, clamp_bound(state, horizontal));
+    c.d_s = clamp_rgb(c.d_s, clamp_bound(state, vertical));
+    return c;
+}
+
+Rgb extrapolate_corner(const ReceiverState& state, const CornerValue& c, double s, double t) {
+    const ReceiverOptions& opt = state.options;
+    const int si = s < 0 ? -1 : 1, ti = t < 0 ? -1 : 1;
     const double s_c = si > 0 ? 1 : 0, t_c = ti > 0 ? 1 : 0;
-    const EdgeProfile& horizontal = state.edges[ti < 0 ? 0 : 2];  // carries d/dt at the corner
-    const EdgeProfile& vertical = state.edges[si > 0 ? 1 : 3];    // carries d/ds at the corner
-    Rgb v, d_t, v2, d_s;
-    horizontal.at(s_c, v, d_t);
-    vertical.at(t_c, v2, d_s);
-    d_t = clamp_rgb(d_t, clamp_bound(horizontal));
-    d_s = clamp_rgb(d_s, clamp_bound(vertical));
-    if (linear)
-        return clamp_to_samples(state, v + (s - s_c) * d_s + (t - t_c) * d_t);  // (24), (25)
-    const double w_s = vertical.h_min, w_t = horizontal.h_min;
+    if (opt.extrapolation == Extrapolation::Linear)
+        return clamp_to_samples(state, c.v + (s - s_c) * c.d_s + (t - t_c) * c.d_t);  // (24-25)
+    const double w_s = state.edges[si > 0 ? 1 : 3].h_min, w_t = state.edges[ti < 0 ? 0 : 2].h_min;
     double phi0_x, phi1_x, phi0_y, phi1_y;
     decay_profiles(opt.extrapolation, std::fabs(s - s_c) / w_s, phi0_x, phi1_x);
     decay_profiles(opt.extrapolation, std::fabs(t - t_c) / w_t, phi0_y, phi1_y);
-    const Rgb d_s_out = double(si) * d_s, d_t_out = double(ti) * d_t;
-    return (phi0_x * phi0_y) * v + (w_s * phi1_x * phi0_y) * d_s_out +
+    const Rgb d_s_out = double(si) * c.d_s, d_t_out = double(ti) * c.d_t;
+    return (phi0_x * phi0_y) * c.v + (w_s * phi1_x * phi0_y) * d_s_out +
            (w_t * phi0_x * phi1_y) * d_t_out;
+}
+
+Rgb extrapolate(const ReceiverState& state, double s, double t) {
+    const int si = s < 0 ? -1 : (s > 1 ? 1 : 0);
+    const int ti = t < 0 ? -1 : (t > 1 ? 1 : 0);
+    MBR_CHECK_MSG(si != 0 || ti != 0, "extrapolate inside the domain at " << s << ", " << t);
+    if (si == 0 || ti == 0) {
+        // Patches 1, 3, 5, 7: along the edge normal, eq. (23) or (26)/(27), from the edge's
+        // value at the point's foot, at its signed offset (t - c or s - b) from the edge.
+        const int e = ti < 0 ? 0 : (si > 0 ? 1 : (ti > 0 ? 2 : 3));
+        const double offset = e == 0 ? t : (e == 1 ? s - 1 : (e == 2 ? t - 1 : s));
+        return extrapolate_side(state, e, edge_value(state, e, (e == 0 || e == 2) ? s : t),
+                                offset);
+    }
+    // Patches 0, 2, 4, 6: from the corner (s_c, t_c), eqs. (24)-(25) or the tensor form.
+    return extrapolate_corner(state, corner_value(state, si > 0 ? 1 : 0, ti > 0 ? 1 : 0), s, t);
 }
 
 // ---- Stage 4: the expanded domain --------------------------------------------------------

@@ -12,6 +12,25 @@ namespace mbr {
 /// derivatives, or the higher-order forms meeting (26) or (27).
 Rgb extrapolate(const ReceiverState& state, double s, double t);
 
+/// What the extrapolation reads of one edge at one point of it: the increment and its
+/// derivative along the edge's normal, clamped (stage 3's profile, EdgeProfile::at).
+struct EdgeValue {
+    Rgb v, d;
+};
+/// Edge e (0: t = 0, 1: s = 1, 2: t = 1, 3: s = 0) at sigma (s on edges 0 and 2, t on 1 and 3).
+EdgeValue edge_value(const ReceiverState& state, int e, double sigma);
+/// extrapolate() on the side patch beyond edge e (patches 1, 3, 5, 7), from the edge's value at
+/// the point's foot, `offset` the point's signed distance from the edge along its normal
+/// coordinate (t, s - 1, t - 1 or s): eq. (23), or (26)/(27).
+Rgb extrapolate_side(const ReceiverState& state, int e, const EdgeValue& at_foot, double offset);
+/// extrapolate() on the corner patch of corner (s_c, t_c) (patches 0, 2, 4, 6), from the value
+/// and clamped derivatives there: eqs. (24)-(25), or the tensor form.
+struct CornerValue {
+    Rgb v, d_s, d_t;
+};
+CornerValue corner_value(const ReceiverState& state, double s_c, double t_c);
+Rgb extrapolate_corner(const ReceiverState& state, const CornerValue& corner, double s, double t);
+
 /// Stage 4. The expanded domain (Figure 5): roots around [0,1]^2 wide enough for the rhombus of
 /// every boundary fulcrum, subdivided adaptively with expanded cells next to the domain no
 /// larger than the domain leaves they touch, scale-adjusted, and sampled by extrapolation.

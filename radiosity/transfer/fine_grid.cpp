@@ -39,6 +39,30 @@ void fill_node_values(const ReceiverState& state, const ProjectionTables& tables
     for (int levels = 1; levels <= J; ++levels)
         for (int index = 0; index < (1 << levels); ++index)
             resample_rows[levels].push_back(subcell_resample_matrix(rule, levels, index));
+    // Outside [0,1]^2 the nodes take extrapolate()'s values, from the edges' values at the
+    // nodes' feet (one EdgeProfile look-up per node column and edge, not per node) and the
+    // corners' values: node k's coordinate along either axis is coordinate[k].
+    std::vector<double> coordinate(static_cast<size_t>(n_nodes));
+    for (int k = 0; k < n_nodes; ++k)
+        coordinate[size_t(k)] = (lo + k / m + 0.5 * (rule.x[k % m] + 1)) / cells;
+    std::vector<EdgeValue> at_foot[4];  // [edge][node index along the edge]
+    for (int e = 0; e < 4; ++e) {
+        at_foot[e].resize(size_t(n_nodes));
+        for (int k = 0; k < n_nodes; ++k)
+            if (coordinate[size_t(k)] > 0 && coordinate[size_t(k)] < 1)
+                at_foot[e][size_t(k)] = edge_value(state, e, coordinate[size_t(k)]);
+    }
+    const CornerValue corner[2][2] = {
+        {corner_value(state, 0, 0), corner_value(state, 0, 1)},
+        {corner_value(state, 1, 0), corner_value(state, 1, 1)}};  // [s_c][t_c]
+    auto outside = [&](int ka, int kb) {  // the value at node (ka, kb) of the grid, outside
+        const double s = coordinate[size_t(ka)], t = coordinate[size_t(kb)];
+        const int si = s < 0 ? -1 : (s > 1 ? 1 : 0), ti = t < 0 ? -1 : (t > 1 ? 1 : 0);
+        if (si != 0 && ti != 0) return extrapolate_corner(state, corner[si > 0][ti > 0], s, t);
+        const int e = ti < 0 ? 0 : (si > 0 ? 1 : (ti > 0 ? 2 : 3));
+        const double offset = e == 0 ? t : (e == 1 ? s - 1 : (e == 2 ? t - 1 : s));
+        return extrapolate_side(state, e, at_foot[e][size_t(e == 0 || e == 2 ? ka : kb)], offset);
+    };
     parallel_for(grid.n_cells, [&](int jj) {
         const int j = lo + jj;
         double channel_in[256], channel_out[256];
@@ -48,10 +72,7 @@ void fill_node_values(const ReceiverState& state, const ProjectionTables& tables
             auto put = [&](int a, int b, Rgb v) { out_base[size_t(b) * n_nodes + a] = v; };
             if (i < 0 || j < 0 || i >= cells || j >= cells) {
                 for (int b = 0; b < m; ++b)
-                    for (int a = 0; a < m; ++a)
-                        put(a, b,
-                            extrapolate(state, (i + 0.5 * (rule.x[a] + 1)) / cells,
-                                        (j + 0.5 * (rule.x[b] + 1)) / cells));
+                    for (int a = 0; a < m; ++a) put(a, b, outside(ii * m + a, jj * m + b));
                 continue;
             }
             const int leaf = forest.find(DyadicCell{J, i, j});
