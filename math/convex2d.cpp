@@ -239,4 +239,49 @@ TriangleRule triangle_rule(int n) {
     return rule;
 }
 
+TriangleRule symmetric_triangle_rule(int degree) {
+    // Orbits in barycentric coordinates (a, a, 1 - 2a) (three points) and (a, b, 1 - a - b)
+    // (six points), with their weights for the unit-area triangle (they sum to 1).
+    struct Orbit {
+        double a, b, weight;  // b < 0: the three-point orbit (a, a, 1 - 2a)
+    };
+    static const Orbit degree2[] = {{1.0 / 6, -1, 1.0 / 3}};
+    static const Orbit degree4[] = {{0.445948490915965, -1, 0.223381589678011},
+                                    {0.091576213509771, -1, 0.109951743655322}};
+    static const Orbit degree6[] = {{0.249286745170910, -1, 0.116786275726379},
+                                    {0.063089014491502, -1, 0.050844906370207},
+                                    {0.053145049844817, 0.310352451033784, 0.082851075618374}};
+    MBR_CHECK_MSG(degree == 2 || degree == 4 || degree == 6,
+                  "no symmetric triangle rule of degree " << degree);
+    const Orbit* first = degree == 2 ? degree2 : (degree == 4 ? degree4 : degree6);
+    const int n_orbits = degree / 2;
+    TriangleRule rule;
+    auto add = [&](double l1, double l2, double weight) {
+        rule.points.push_back({l1, l2});  // (x, y) = the weights of corners (1,0) and (0,1)
+        rule.weights.push_back(0.5 * weight);
+    };
+    for (int k = 0; k < n_orbits; ++k) {
+        const Orbit& o = first[k];
+        if (o.b < 0) {
+            const double c = 1 - 2 * o.a;
+            add(o.a, o.a, o.weight);
+            add(o.a, c, o.weight);
+            add(c, o.a, o.weight);
+        } else {
+            const double c = 1 - o.a - o.b;
+            add(o.a, o.b, o.weight);
+            add(o.b, o.a, o.weight);
+            add(o.a, c, o.weight);
+            add(c, o.a, o.weight);
+            add(o.b, c, o.weight);
+            add(c, o.b, o.weight);
+        }
+    }
+    return rule;
+}
+
+TriangleRule triangle_rule_of_degree_2n_minus_2(int n) {
+    return n >= 2 && n <= 4 ? symmetric_triangle_rule(2 * n - 2) : triangle_rule(n);
+}
+
 }  // namespace mbr

@@ -94,4 +94,14 @@ struct TriangleRule {
 };
 TriangleRule triangle_rule(int n);
 
+/// A fully symmetric rule on the same reference triangle, exact for polynomials of total degree
+/// `degree` = 2, 4 or 6 with 3, 6 or 12 points (Strang and Fix 1973; Dunavant 1985), weights
+/// summing to 1/2: the collapsed rule of the same degree needs 4, 9 or 16 points, crowded at
+/// the collapsed corner.
+TriangleRule symmetric_triangle_rule(int degree);
+
+/// The rule with the fewest points that this file knows exact for total degree 2n - 2: the
+/// symmetric one for n = 2, 3, 4, else the collapsed n x n rule.
+TriangleRule triangle_rule_of_degree_2n_minus_2(int n);
+
 }  // namespace mbr

@@ -34,7 +34,7 @@ IncrementIntegrator::IncrementIntegrator(const Shooter& shooter, const Quadratur
         plane_ = make_shooter_plane(*shooter.surface);
         const int top = std::max(options.n, options.n_pieces) + 1;
         tri_rules_.resize(top + 1);
-        for (int n = 1; n <= top; ++n) tri_rules_[n] = triangle_rule(n);
+        for (int n = 1; n <= top; ++n) tri_rules_[n] = triangle_rule_of_degree_2n_minus_2(n);
     }
     if (occlusion && !occlusion->clear()) occlusion_ = occlusion;
     analytic_ = planar_ && unshot_constant_ && options.analytic;
