@@ -151,7 +151,7 @@ IncrementIntegrator::ShadowTriangleCorners IncrementIntegrator::triangle_corners
 
 Rgb IncrementIntegrator::triangle_value(const SurfacePoint& p, const ShadowTriangleCorners& t,
                                         int n) {
-    // The n x n collapsed Gauss rule on one triangle of the shooter's plane:
+    // The triangle rule of degree 2n - 2 (tri_rules_[n]) on one triangle of the shooter's plane:
     // int F(p, x) (B_h(u(x), v(x)) - b*) dA(x).
     const TriangleRule& rule = tri_rules_[n];
     Rgb sum;
@@ -171,8 +171,8 @@ Rgb IncrementIntegrator::triangle_value(const SurfacePoint& p, const ShadowTrian
         if (F == 0) continue;
         Rgb B = constant_b;
         if (!unshot_constant_) {
-            // At a node, the corners' affine blend refined by a Newton step (the inverse of the
-            // bilinear map is nearly affine over one triangle).
+            // At a node, the corners' affine blend refined by two Newton steps (the inverse of
+            // the bilinear map is nearly affine over one triangle).
             const Vec2 guess = t.uv_a + xi * (t.uv_b - t.uv_a) + eta * (t.uv_c - t.uv_a);
             const Vec2 uv = plane_.refine_parameters(X, plane_.refine_parameters(X, guess));
             B = unshot_patches_(uv.x, uv.y);
@@ -339,9 +339,9 @@ ConvexPolygon IncrementIntegrator::cell_image(const QuadCell& cell) const {
 
 Rgb IncrementIntegrator::pieces_value(const SurfacePoint& p,
                                       const std::vector<ConvexPolygon>& pieces, int n) {
-    // The n x n collapsed Gauss rule on a fan of triangles of each convex piece, in the shooter's
-    // plane: int F(p, x) B_h(u(x), v(x)) dA(x) (dA is the plane's own area element, so the area
-    // factor A_h of the parameter map does not appear).
+    // The triangle rule of degree 2n - 2 on a fan of triangles of each convex piece, in the
+    // shooter's plane: int F(p, x) B_h(u(x), v(x)) dA(x) (dA is the plane's own area element, so
+    // the area factor A_h of the parameter map does not appear).
     // The cell's n or n+1 stands for the pieces' pair (n_pieces, n_pieces + 1).
     const int np = options_.n_pieces > 0 ? options_.n_pieces + (n - options_.n) : n;
     const TriangleRule& rule = tri_rules_[np];

@@ -64,8 +64,9 @@ struct QuadratureOptions {
                                      //   horizon, and the shadowed part (the union of the shadows
                                      //   in front) is integrated on its own and subtracted; else
                                      //   each cut cell's visible pieces are integrated
-    int n_pieces = 0;                // the rule pair on cut cells' pieces: n_pieces against
-                                     //   n_pieces + 1 points per triangle side (0: n, as cells)
+    int n_pieces = 0;                // the rule pair on cut cells' pieces and shadow triangles:
+                                     //   the triangle rules of degrees 2 n_pieces - 2 and
+                                     //   2 n_pieces (0: n, as cells)
     bool subtract = true;            // planar quad shooters of varying radiosity: I(p) =
                                      //   B_h(x*) F(p -> visible part) + int F (B_h - B_h(x*)),
                                      //   the first term by the contour formula (x* the foot of p
@@ -223,7 +224,7 @@ private:
         double jacobian;
     };
     ShadowTriangleCorners triangle_corners(Vec2 a, Vec2 b, Vec2 c) const;
-    /// The n x n collapsed Gauss rule of F (B_h - b*) on the triangle.
+    /// The triangle rule of degree 2n - 2 (tri_rules_[n]) of F (B_h - b*) on the triangle.
     Rgb triangle_value(const SurfacePoint& p, const ShadowTriangleCorners& t, int n);
     /// int F (B_h - b*) over the shadowed part (shadow_regions_) to `tolerance`, adaptively
     /// over its fan triangles; the triangles kept are appended to *kept.
@@ -242,7 +243,7 @@ private:
     long n_analytic_ = 0;                  // visible_form_factor calls (n_analytic())
     ShooterPlane plane_;                   // its frame
     BlockedView view_;                     // what the current point cannot see
-    std::vector<TriangleRule> tri_rules_;  // tri_rules_[n]
+    std::vector<TriangleRule> tri_rules_;  // tri_rules_[n]: exact for degree 2n - 2
     long extra_evaluations_ = 0;           // kernel evaluations on cut pieces (current point)
     long rays_ = 0;                        // rays cast for the current point
     Rgb b_star_;                           // the constant subtracted from B_h (zero: none)
