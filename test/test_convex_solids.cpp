@@ -102,6 +102,41 @@ TEST_CASE("convex solids: which sets of faces bound a convex solid", "[shadow][c
         CHECK(s.solid_of[7] == 1);
         CHECK(s.solid_of[11] == -1);
     }
+    SECTION("a block meshed with the floor it stands on: the block alone (a concave edge at its "
+            "foot)") {
+        // The floor as four quads around the block's footprint, sharing the footprint's edges
+        // with the block's sides.
+        std::vector<Polygon> faces = box_faces({1, 0, 1}, {2, 1, 2}, 0, false);
+        const Vec3 o[4] = {{0, 0, 0}, {3, 0, 0}, {3, 0, 3}, {0, 0, 3}};  // the floor's corners
+        const Vec3 f[4] = {{1, 0, 1}, {2, 0, 1}, {2, 0, 2}, {1, 0, 2}};  // the footprint's
+        for (int k = 0; k < 4; ++k)  // counter-clockwise seen from above (+y)
+            faces.emplace_back(std::vector<Vec3>{o[k], f[k], f[(k + 1) % 4], o[(k + 1) % 4]},
+                               no_uv(4), 10 + k);
+        for (Polygon& p : faces) {  // the floor quads must face up
+            if (p.surface() >= 10 && p.normal().y < 0) {
+                std::vector<Vec3> v = p.vertices();
+                std::reverse(v.begin(), v.end());
+                p = Polygon(v, no_uv(4), p.surface());
+            }
+        }
+        const ConvexSolids s = find_convex_solids(faces);
+        REQUIRE(s.solids.size() == 1);
+        CHECK(s.solids[0].polygons == std::vector<int>{0, 1, 2, 3, 4});
+        CHECK(s.solids[0].open);
+    }
+    SECTION("a box with a T-junction: one side split in two, its neighbours not") {
+        std::vector<Polygon> faces = box_faces({0, 0, 0}, {2, 1, 1}, 0, true);
+        // Face 1 (z = 0, corners (0,0,0) (0,1,0) (2,1,0) (2,0,0)) as two quads split at x = 1.
+        faces.erase(faces.begin() + 1);
+        faces.emplace_back(std::vector<Vec3>{{0, 0, 0}, {0, 1, 0}, {1, 1, 0}, {1, 0, 0}},
+                           no_uv(4), 6);
+        faces.emplace_back(std::vector<Vec3>{{1, 0, 0}, {1, 1, 0}, {2, 1, 0}, {2, 0, 0}},
+                           no_uv(4), 7);
+        const ConvexSolids s = find_convex_solids(faces);
+        REQUIRE(s.solids.size() == 1);
+        CHECK(s.solids[0].polygons.size() == 7);
+        CHECK_FALSE(s.solids[0].open);
+    }
     SECTION("not solids: faces looking inward, two faces only, two missing faces, an L") {
         std::vector<Polygon> inward;
         for (const Polygon& p : box_faces({0, 0, 0}, {1, 1, 1}, 0, true)) {

@@ -43,13 +43,10 @@ int find_root(std::vector<int>& parent, int a) {
     return a;
 }
 
-/// One use of an undirected edge by a face: the face and whether it runs from the smaller
-/// vertex id to the larger.
+/// The faces that use an undirected edge: how many, and the first two.
 struct EdgeUses {
     int count = 0;
-    int first_polygon = -1;
-    bool first_forward = false;
-    bool opposed = true;  // a second use runs the other way
+    int first = -1, second = -1;
 };
 
 std::uint64_t edge_key(int a, int b) {
@@ -60,8 +57,7 @@ std::uint64_t edge_key(int a, int b) {
 std::optional<ConvexSolid> make_solid(const std::vector<Polygon>& polygons,
                                       const std::vector<int>& faces,
                                       const std::vector<std::vector<int>>& corner_ids,
-                                      const std::vector<Vec3>& points,
-                                      const std::unordered_map<std::uint64_t, EdgeUses>& uses) {
+                                      const std::vector<Vec3>& points) {
     ConvexSolid solid;
     solid.polygons = faces;
     std::vector<int> local;  // scene vertex ids of the solid, sorted
@@ -91,23 +87,66 @@ std::optional<ConvexSolid> make_solid(const std::vector<Polygon>& polygons,
         solid.faces.push_back(plane);
     }
     if (!volume) return std::nullopt;  // flat: coplanar faces bound no solid
-    // Edges: each once; those of one face only are the missing face's outline.
-    Vec3 centre{0, 0, 0};
-    std::vector<std::array<Vec3, 2>> outline;  // directed as their face runs them
+    // Edges within the solid: each in two of its faces, run in opposite directions, or in one
+    // (the missing face's outline); each listed once.
+    struct DirectedEdge {
+        std::uint64_t key;
+        int a, b;  // scene vertex ids, in the face's order
+    };
+    std::vector<DirectedEdge> directed;
     for (int f : faces) {
         const std::vector<int>& ids = corner_ids[size_t(f)];
         for (size_t k = 0; k < ids.size(); ++k) {
             const int a = ids[k], b = ids[(k + 1) % ids.size()];
-            const EdgeUses& use = uses.at(edge_key(a, b));
-            if (use.count > 2 || !use.opposed) return std::nullopt;
-            if (use.count == 2 && use.first_polygon != f) continue;  // listed by its first face
-            solid.edges.push_back({index_of(a), index_of(b)});
-            if (use.count == 1) {
-                outline.push_back({points[size_t(a)], points[size_t(b)]});
-                solid.missing_outline.push_back(index_of(a));
-                centre = centre + points[size_t(a)];
-            }
+            directed.push_back({edge_key(a, b), a, b});
         }
+    }
+    std::sort(directed.begin(), directed.end(), [](const DirectedEdge& x, const DirectedEdge& y) {
+        return x.key < y.key || (x.key == y.key && x.a < y.a);
+    });
+    std::vector<DirectedEdge> single;  // edges of one face
+    for (size_t k = 0; k < directed.size();) {
+        size_t end = k + 1;
+        while (end < directed.size() && directed[end].key == directed[k].key) ++end;
+        if (end - k > 2) return std::nullopt;
+        if (end - k == 2 && directed[k].a == directed[k + 1].a) return std::nullopt;  // same way
+        const DirectedEdge& e = directed[k];
+        solid.edges.push_back({index_of(e.a), index_of(e.b)});
+        if (end - k == 1) single.push_back(e);
+        k = end;
+    }
+    // A mesh with T-junctions splits an edge on one side and not on the other: an edge of one
+    // face is still inside the surface when edges of others, on its line and run the other way,
+    // cover it. The rest are the missing face's outline.
+    auto covered = [&](const DirectedEdge& e) {
+        const Vec3 a = points[size_t(e.a)], d = points[size_t(e.b)] - a;
+        const double len2 = dot(d, d);
+        std::vector<std::array<double, 2>> spans;  // parameters along e of the covering edges
+        for (const DirectedEdge& f : single) {
+            const Vec3 c = points[size_t(f.a)], g = points[size_t(f.b)];
+            if (dot(g - c, d) >= 0) continue;  // not run the other way
+            if (length(cross(c - a, d)) > tol * std::sqrt(len2) ||
+                length(cross(g - a, d)) > tol * std::sqrt(len2))
+                continue;  // not on e's line
+            const double t0 = dot(g - a, d) / len2, t1 = dot(c - a, d) / len2;
+            spans.push_back({t0, t1});
+        }
+        std::sort(spans.begin(), spans.end());
+        const double slack = tol / std::sqrt(len2);
+        double reach = 0;
+        for (const auto& span : spans) {
+            if (span[0] > reach + slack) break;
+            reach = std::max(reach, span[1]);
+        }
+        return reach >= 1 - slack;
+    };
+    Vec3 centre{0, 0, 0};
+    std::vector<std::array<Vec3, 2>> outline;  // directed as their face runs them
+    for (const DirectedEdge& e : single) {
+        if (covered(e)) continue;
+        outline.push_back({points[size_t(e.a)], points[size_t(e.b)]});
+        solid.missing_outline.push_back(index_of(e.a));
+        centre = centre + points[size_t(e.a)];
     }
     if (outline.empty()) return solid;  // closed
     // The missing face: the plane of the outline, which must support the solid.
@@ -149,22 +188,32 @@ ConvexSolids find_convex_solids(const std::vector<Polygon>& polygons) {
             corner_ids[size_t(f)].push_back(it->second);
         }
     std::unordered_map<std::uint64_t, EdgeUses> uses;
-    std::vector<int> parent(static_cast<size_t>(n));
-    std::iota(parent.begin(), parent.end(), 0);
     for (int f = 0; f < n; ++f) {
         const std::vector<int>& ids = corner_ids[size_t(f)];
         for (size_t k = 0; k < ids.size(); ++k) {
-            const int a = ids[k], b = ids[(k + 1) % ids.size()];
-            EdgeUses& use = uses[edge_key(a, b)];
-            if (use.count == 0) {
-                use.first_polygon = f;
-                use.first_forward = a < b;
-            } else {
-                if ((a < b) == use.first_forward) use.opposed = false;
-                parent[size_t(find_root(parent, f))] = find_root(parent, use.first_polygon);
-            }
+            EdgeUses& use = uses[edge_key(ids[k], ids[(k + 1) % ids.size()])];
+            (use.count == 0 ? use.first : use.second) = f;
             ++use.count;
         }
+    }
+    // Faces are joined across an edge they share (with no third face) where it is convex or
+    // flat: each face's corners lie behind the other's plane or on it, within 1e-9 of the pair's
+    // size. So a block's faces are one set, and a floor meshed together with the blocks on it
+    // (a concave edge at every block's foot) is not joined to them.
+    auto behind = [&](int f, int g) {
+        const Plane& plane = polygons[size_t(f)].plane();
+        const double tol =
+            1e-9 * std::max(polygons[size_t(f)].diameter(), polygons[size_t(g)].diameter());
+        for (const Vec3& v : polygons[size_t(g)].vertices())
+            if (plane.signed_distance(v) > tol) return false;
+        return true;
+    };
+    std::vector<int> parent(static_cast<size_t>(n));
+    std::iota(parent.begin(), parent.end(), 0);
+    for (const auto& entry : uses) {
+        const EdgeUses& use = entry.second;
+        if (use.count == 2 && behind(use.first, use.second) && behind(use.second, use.first))
+            parent[size_t(find_root(parent, use.first))] = find_root(parent, use.second);
     }
     std::unordered_map<int, std::vector<int>> components;
     for (int f = 0; f < n; ++f) components[find_root(parent, f)].push_back(f);
@@ -176,7 +225,7 @@ ConvexSolids find_convex_solids(const std::vector<Polygon>& polygons) {
     std::sort(groups.begin(), groups.end(),
               [](const std::vector<int>& a, const std::vector<int>& b) { return a[0] < b[0]; });
     for (const std::vector<int>& faces : groups) {
-        std::optional<ConvexSolid> solid = make_solid(polygons, faces, corner_ids, points, uses);
+        std::optional<ConvexSolid> solid = make_solid(polygons, faces, corner_ids, points);
         if (!solid) continue;
         for (int f : faces) out.solid_of[size_t(f)] = int(out.solids.size());
         out.solids.push_back(std::move(*solid));
