@@ -479,84 +479,67 @@ TEST_CASE("convex2d: inverse_bilinear undoes the bilinear map of convex quads", 
                         << " inside, " << worst_outside << " slightly outside\n";
 }
 
+namespace {
+
+/// Checks a rule on the triangle (0,0) (1,0) (0,1): positive weights summing to its area 1/2,
+/// points in the closed triangle, every monomial x^a y^b of total degree <= `degree` integrated
+/// to 1e-13 relative (int x^a y^b = a! b! / (a + b + 2)!), and x^(degree + 2) missed: the check
+/// that the test can fail.
+void check_triangle_rule(const TriangleRule& rule, int degree) {
+    REQUIRE(rule.weights.size() == rule.points.size());
+    double w_sum = 0;
+    for (size_t q = 0; q < rule.points.size(); ++q) {
+        const Vec2 x = rule.points[q];
+        CHECK(rule.weights[q] > 0);
+        CHECK(x.x >= 0);
+        CHECK(x.y >= 0);
+        CHECK(x.x + x.y <= 1);
+        w_sum += rule.weights[q];
+    }
+    CHECK(w_sum == Approx(0.5).epsilon(1e-14));
+    auto integrate = [&](int a, int b) {
+        double sum = 0;
+        for (size_t q = 0; q < rule.points.size(); ++q)
+            sum += rule.weights[q] * std::pow(rule.points[q].x, a) * std::pow(rule.points[q].y, b);
+        return sum;
+    };
+    for (int deg = 0; deg <= degree; ++deg)
+        for (int a = 0; a <= deg; ++a) {
+            const int b = deg - a;
+            CAPTURE(degree, a, b);
+            CHECK(integrate(a, b) ==
+                  Approx(factorial(a) * factorial(b) / factorial(a + b + 2)).epsilon(1e-13));
+        }
+    const double beyond = factorial(degree + 2) / factorial(degree + 4);
+    CAPTURE(degree);
+    CHECK(std::fabs(integrate(degree + 2, 0) - beyond) > 1e-10 * beyond);
+}
+
+}  // namespace
+
 TEST_CASE("convex2d: triangle_rule integrates monomials of degree 2n - 2 exactly", "[convex2d]") {
-    // int over the triangle (0,0) (1,0) (0,1) of x^a y^b = a! b! / (a + b + 2)!. The collapsed
-    // (Duffy) n x n rule is exact for total degree <= 2n - 2: 1e-14 relative is rounding. At
-    // degree 2n (beyond its reach) it must miss: the check that the test can fail.
+    // The collapsed (Duffy) n x n rule is exact for total degree <= 2n - 2; at degree 2n, beyond
+    // its reach in the collapsed variable, it misses.
     for (int n = 1; n <= 8; ++n) {
         const TriangleRule rule = triangle_rule(n);
         REQUIRE(rule.points.size() == size_t(n) * n);
-        REQUIRE(rule.weights.size() == size_t(n) * n);
-        double w_sum = 0;
-        for (size_t q = 0; q < rule.points.size(); ++q) {
-            const Vec2 x = rule.points[q];
-            CHECK(rule.weights[q] > 0);
-            CHECK(x.x >= 0);
-            CHECK(x.y >= 0);
-            CHECK(x.x + x.y <= 1);
-            w_sum += rule.weights[q];
-        }
-        CHECK(w_sum == Approx(0.5).epsilon(1e-14));
-        auto integrate = [&](int a, int b) {
-            double sum = 0;
-            for (size_t q = 0; q < rule.points.size(); ++q)
-                sum +=
-                    rule.weights[q] * std::pow(rule.points[q].x, a) * std::pow(rule.points[q].y, b);
-            return sum;
-        };
-        for (int deg = 0; deg <= 2 * n - 2; ++deg)
-            for (int a = 0; a <= deg; ++a) {
-                const int b = deg - a;
-                const double exact = factorial(a) * factorial(b) / factorial(a + b + 2);
-                CAPTURE(n, a, b);
-                CHECK(integrate(a, b) == Approx(exact).epsilon(1e-13));
-            }
-        // x^(2n): not integrated exactly (the rule has degree 2n - 2 in the collapsed variable).
-        const double exact = factorial(2 * n) / factorial(2 * n + 2);
-        CAPTURE(n);
-        CHECK(std::fabs(integrate(2 * n, 0) - exact) > 1e-10 * exact);
+        check_triangle_rule(rule, 2 * n - 2);
     }
 }
 
 TEST_CASE("convex2d: the symmetric triangle rules integrate monomials of their degree exactly",
           "[convex2d]") {
-    // Strang-Fix / Dunavant rules of degree 2, 4 and 6 (3, 6 and 12 points): every monomial
-    // x^a y^b with a + b <= degree to 1e-13 relative (their constants carry 15 digits), and one
-    // of the next degree missed (the check that the test can fail); triangle_rule_of_degree_2n_minus_2
-    // takes them for n = 2, 3, 4 and the collapsed rule beyond.
+    // Strang-Fix / Dunavant rules of degree 2, 4 and 6 (3, 6 and 12 points, inside the triangle;
+    // their constants carry 15 digits); triangle_rule_of_degree_2n_minus_2 takes them for
+    // n = 2, 3, 4 and the collapsed rule beyond.
     const int points[] = {0, 0, 3, 0, 6, 0, 12};
     for (int degree : {2, 4, 6}) {
         const TriangleRule rule = symmetric_triangle_rule(degree);
         REQUIRE(rule.points.size() == size_t(points[degree]));
         CHECK(triangle_rule_of_degree_2n_minus_2(degree / 2 + 1).points.size() ==
               rule.points.size());
-        double w_sum = 0;
-        for (size_t q = 0; q < rule.points.size(); ++q) {
-            const Vec2 x = rule.points[q];
-            CHECK(rule.weights[q] > 0);
-            CHECK(x.x > 0);
-            CHECK(x.y > 0);
-            CHECK(x.x + x.y < 1);
-            w_sum += rule.weights[q];
-        }
-        CHECK(w_sum == Approx(0.5).epsilon(1e-14));
-        auto integrate = [&](int a, int b) {
-            double sum = 0;
-            for (size_t q = 0; q < rule.points.size(); ++q)
-                sum +=
-                    rule.weights[q] * std::pow(rule.points[q].x, a) * std::pow(rule.points[q].y, b);
-            return sum;
-        };
-        for (int deg = 0; deg <= degree; ++deg)
-            for (int a = 0; a <= deg; ++a) {
-                const int b = deg - a;
-                CAPTURE(degree, a, b);
-                CHECK(integrate(a, b) ==
-                      Approx(factorial(a) * factorial(b) / factorial(a + b + 2)).epsilon(1e-13));
-            }
-        const double beyond = factorial(degree + 2) / factorial(degree + 4);
-        CAPTURE(degree);
-        CHECK(std::fabs(integrate(degree + 2, 0) - beyond) > 1e-10 * beyond);
+        for (const Vec2& x : rule.points) CHECK((x.x > 0 && x.y > 0 && x.x + x.y < 1));
+        check_triangle_rule(rule, degree);
     }
     CHECK(triangle_rule_of_degree_2n_minus_2(1).points.size() == 1);
     CHECK(triangle_rule_of_degree_2n_minus_2(5).points.size() == 25);
