@@ -5,9 +5,11 @@
 // "Shadow", with exact visibility; issue 20, "one silhouette per occluder").
 //
 // A solid here is a set of polygons, connected through shared edges (the same two vertices, to
-// the bit), that bounds a convex polyhedron K: every vertex lies behind every face's plane (the
-// faces look outward), each edge belongs to two faces, except the edges of at most one missing
-// face (a block standing on the floor has no bottom), which lie in one plane that supports K.
+// the bit) that are convex or flat (a floor meshed with the block on it is not joined to it),
+// that bounds a convex polyhedron K: every vertex lies behind every face's plane (the faces look
+// outward), each edge belongs to two faces or is covered by edges of others on its line (a
+// T-junction), except the edges of at most one missing face (a block standing on the floor has
+// no bottom), which lie in one plane that supports K.
 // Seen from a point p outside K, every ray through K crosses a face of the set, unless it enters
 // through the missing face and ends inside K (checked per point: solid_shadow), so the union of
 // the faces' shadows is the shadow of K: the convex hull of the projected corners of K cut to the
