@@ -635,6 +635,70 @@ TEST_CASE("hidden regions: texels no smaller than 1/2048 of the scene, 4 to 64 a
     }
 }
 
+TEST_CASE("hidden regions: the octree's contacts find every hidden texel that rays from all "
+          "texels find",
+          "[solver][hidden]") {
+    // A floor with a block resting on it, a block sunk into it, a cylinder (a leg) standing on
+    // it, a one-sided lamp hung 1e-3 under the ceiling, a block floating in the middle and a
+    // wall: the floor under the blocks and the leg, the ceiling over the lamp, and the sunk
+    // block's faces below the floor are hidden; the floating block and the wall touch nothing.
+    std::istringstream in(
+        "material white reflectance 0.5 0.5 0.5\n"
+        "rectangle floor white -2 0 -2  0 0 4  4 0 0\n"
+        "rectangle ceiling white -2 2 -2  4 0 0  0 0 4\n"
+        "rectangle wall white -2 0 -2  4 0 0  0 2 0\n"
+        "rectangle lamp white -0.5 1.999 -0.5  1 0 0  0 0 1\n"
+        "box resting white -1.5 0 -1.5  -0.9 0.4 -0.9\n"
+        "box sunk white 0.5 -0.2 0.5  1.1 0.3 1.1\n"
+        "box floating white -0.2 0.8 -0.2  0.2 1.2 0.2\n"
+        "cylinder leg white 1.5 0 -1.5  0 1 0  1 0 0  0.05 0.7  0 360\n");
+    const Scene scene = parse_scene(in, "contacts.scene");
+    const Octree octree = build_octree(scene);
+    const int n = int(scene.surfaces.size());
+    const std::vector<std::vector<int>> contacts = find_contact_occluders(octree, n);
+    REQUIRE(int(contacts.size()) == n);
+    auto listed = [&](const std::string& name) {
+        return !contacts[size_t(scene.find_surface(name))].empty();
+    };
+    CHECK(listed("floor"));
+    CHECK(listed("ceiling"));
+    CHECK_FALSE(listed("wall"));
+    for (const SceneSurface& s : scene.surfaces)
+        if (s.name.rfind("floating", 0) == 0) CHECK_FALSE(listed(s.name));
+    // The ceiling's list is the lamp's polygon.
+    const std::vector<int>& over_lamp = contacts[size_t(scene.find_surface("ceiling"))];
+    REQUIRE(over_lamp.size() == 1);
+    CHECK(octree.polygons()[size_t(over_lamp[0])].surface() == scene.find_surface("lamp"));
+    long hidden_texels = 0, filtered_texels = 0;
+    for (int i = 0; i < n; ++i) {
+        const Surface& surface = scene.surfaces[size_t(i)].surface;
+        const HiddenMask full = find_hidden(surface, i, octree);
+        const HiddenMask filtered = contacts[size_t(i)].empty()
+                                        ? HiddenMask()
+                                        : find_hidden(surface, i, octree, &contacts[size_t(i)]);
+        hidden_texels += full.hidden_count();
+        filtered_texels += filtered.hidden_count();
+        const int r = full.resolution();
+        long differ = 0;
+        for (int j = 0; j < r; ++j)
+            for (int k = 0; k < r; ++k)
+                differ += full.hidden((k + 0.5) / r, (j + 0.5) / r) !=
+                          filtered.hidden((k + 0.5) / r, (j + 0.5) / r);
+        CAPTURE(scene.surfaces[size_t(i)].name, full.hidden_count(), filtered.hidden_count());
+        CHECK(differ == 0);
+    }
+    test::report() << "contacts: " << hidden_texels << " hidden texels by every texel's rays, "
+                   << filtered_texels << " through the contacts\n";
+    // The floor under two blocks and a leg, the ceiling over the lamp, the sunk block's sides.
+    CHECK(hidden_texels > 400);
+    // (s, t) = ((z + 2) / 4, (x + 2) / 4) on the floor: under the resting and the sunk block's
+    // centres hidden, between them visible.
+    const HiddenMask floor = find_hidden(scene.surfaces[0].surface, 0, octree, &contacts[0]);
+    CHECK(floor.hidden(0.2, 0.2));
+    CHECK(floor.hidden(0.7, 0.7));
+    CHECK_FALSE(floor.hidden(0.125, 0.5));
+}
+
 TEST_CASE("shadows auto: exact between few occluding surfaces, the paper's between many",
           "[solver][shadows]") {
     // A lamp above a floor with n small boxes between them (six surfaces each): the lamp-to-

@@ -389,11 +389,18 @@ ProgressiveSolver::ProgressiveSolver(const Scene& scene, const Octree& octree,
     if (options.receiver.shadows.method == ShadowMethod::Exact)
         solids_ = std::make_unique<ConvexSolids>(find_convex_solids(octree.polygons()));
     hidden_.resize(n);
-    if (options.hidden_regions)
+    if (options.hidden_regions) {
+        // DESIGN: only the surfaces that another polygon touches from in front can hold a
+        // hidden region, and only near those polygons (find_contact_occluders); the others
+        // keep an empty mask.
+        const std::vector<std::vector<int>> contacts = find_contact_occluders(octree, n);
         for (int i = 0; i < n; ++i) {
-            hidden_[i] = find_hidden(scene.surfaces[i].surface, i, octree);  // parallel inside
+            if (!contacts[size_t(i)].empty())  // parallel inside
+                hidden_[i] =
+                    find_hidden(scene.surfaces[i].surface, i, octree, &contacts[size_t(i)]);
             if (on_setup) on_setup(i + 1, n);
         }
+    }
     // "for each emitting surface L_i compute the projection of its emittance distribution".
     double emitted = 0;
     Rgb emitted_rgb;
