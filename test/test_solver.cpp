@@ -655,10 +655,10 @@ TEST_CASE("hidden regions: the octree's contacts find every hidden texel that ra
     const Scene scene = parse_scene(in, "contacts.scene");
     const Octree octree = build_octree(scene);
     const int n = int(scene.surfaces.size());
-    const std::vector<std::vector<int>> contacts = find_contact_occluders(octree, n);
-    REQUIRE(int(contacts.size()) == n);
+    const HiddenContacts contacts = find_contacts(octree, n);
+    REQUIRE(int(contacts.occluders.size()) == n);
     auto listed = [&](const std::string& name) {
-        return !contacts[size_t(scene.find_surface(name))].empty();
+        return !contacts.occluders[size_t(scene.find_surface(name))].empty();
     };
     CHECK(listed("floor"));
     CHECK(listed("ceiling"));
@@ -666,16 +666,16 @@ TEST_CASE("hidden regions: the octree's contacts find every hidden texel that ra
     for (const SceneSurface& s : scene.surfaces)
         if (s.name.rfind("floating", 0) == 0) CHECK_FALSE(listed(s.name));
     // The ceiling's list is the lamp's polygon.
-    const std::vector<int>& over_lamp = contacts[size_t(scene.find_surface("ceiling"))];
+    const std::vector<int>& over_lamp = contacts.occluders[size_t(scene.find_surface("ceiling"))];
     REQUIRE(over_lamp.size() == 1);
     CHECK(octree.polygons()[size_t(over_lamp[0])].surface() == scene.find_surface("lamp"));
     long hidden_texels = 0, filtered_texels = 0;
     for (int i = 0; i < n; ++i) {
         const Surface& surface = scene.surfaces[size_t(i)].surface;
         const HiddenMask full = find_hidden(surface, i, octree);
-        const HiddenMask filtered = contacts[size_t(i)].empty()
+        const HiddenMask filtered = contacts.occluders[size_t(i)].empty()
                                         ? HiddenMask()
-                                        : find_hidden(surface, i, octree, &contacts[size_t(i)]);
+                                        : find_hidden(surface, i, octree, &contacts);
         hidden_texels += full.hidden_count();
         filtered_texels += filtered.hidden_count();
         const int r = full.resolution();
@@ -693,7 +693,7 @@ TEST_CASE("hidden regions: the octree's contacts find every hidden texel that ra
     CHECK(hidden_texels > 400);
     // (s, t) = ((z + 2) / 4, (x + 2) / 4) on the floor: under the resting and the sunk block's
     // centres hidden, between them visible.
-    const HiddenMask floor = find_hidden(scene.surfaces[0].surface, 0, octree, &contacts[0]);
+    const HiddenMask floor = find_hidden(scene.surfaces[0].surface, 0, octree, &contacts);
     CHECK(floor.hidden(0.2, 0.2));
     CHECK(floor.hidden(0.7, 0.7));
     CHECK_FALSE(floor.hidden(0.125, 0.5));

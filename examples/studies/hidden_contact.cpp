@@ -1,6 +1,6 @@
 // examples/studies/hidden_contact.cpp - the hidden-region setup (radiosity/visibility/
 // hidden_regions.h) with and without the contact filter: which polygons the octree finds in
-// contact with each surface (find_contact_occluders), and whether the masks that the solver
+// contact with each surface (find_contacts), and whether the masks that the solver
 // computes from them (find_hidden with the lists: seed texels near the contacts, grown over
 // the hidden ones) miss any texel that the full test (rays from every texel) finds hidden.
 //
@@ -42,7 +42,7 @@ int run(mbr::Args& args) {
     const int n = static_cast<int>(scene.surfaces.size());
 
     double t0 = mbr::now_seconds();
-    const std::vector<std::vector<int>> contacts = mbr::find_contact_occluders(octree, n);
+    const mbr::HiddenContacts contacts = mbr::find_contacts(octree, n);
     const double contact_seconds = mbr::now_seconds() - t0;
 
     int n_contact = 0, n_hidden = 0, n_missed = 0;
@@ -56,10 +56,10 @@ int run(mbr::Args& args) {
         full_seconds += mbr::now_seconds() - t0;
         texels += long(mask.resolution()) * mask.resolution();
         mbr::HiddenMask filtered;
-        if (!contacts[size_t(i)].empty()) {
+        if (!contacts.occluders[size_t(i)].empty()) {
             ++n_contact;
             t0 = mbr::now_seconds();
-            filtered = mbr::find_hidden(surface, i, octree, &contacts[size_t(i)]);
+            filtered = mbr::find_hidden(surface, i, octree, &contacts);
             filtered_seconds += mbr::now_seconds() - t0;
         }
         if (!mask.any()) continue;

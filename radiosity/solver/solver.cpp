@@ -391,13 +391,12 @@ ProgressiveSolver::ProgressiveSolver(const Scene& scene, const Octree& octree,
     hidden_.resize(n);
     if (options.hidden_regions) {
         // DESIGN: only the surfaces that another polygon touches from in front can hold a
-        // hidden region, and only near those polygons (find_contact_occluders); the others
-        // keep an empty mask.
-        const std::vector<std::vector<int>> contacts = find_contact_occluders(octree, n);
+        // hidden region, and only near those polygons (find_contacts); the others keep an
+        // empty mask.
+        const HiddenContacts contacts = find_contacts(octree, n);
         for (int i = 0; i < n; ++i) {
-            if (!contacts[size_t(i)].empty())  // parallel inside
-                hidden_[i] =
-                    find_hidden(scene.surfaces[i].surface, i, octree, &contacts[size_t(i)]);
+            if (!contacts.occluders[size_t(i)].empty())  // parallel inside
+                hidden_[i] = find_hidden(scene.surfaces[i].surface, i, octree, &contacts);
             if (on_setup) on_setup(i + 1, n);
         }
     }

@@ -7,6 +7,7 @@
 
 #include "math/check.h"
 #include "math/parallel.h"
+#include "radiosity/visibility/convex_solids.h"
 #include "radiosity/visibility/occlusion.h"
 
 namespace mbr {
@@ -71,6 +72,48 @@ Vec2 HiddenMask::substitute(double s, double t) const {
     return hidden_[k] ? substitute_[k] : Vec2{s, t};
 }
 
+namespace {
+
+/// The largest signed distance of a polygon's vertices from `plane` (positive in front).
+double highest_above(const Polygon& polygon, const Plane& plane) {
+    double most = -HUGE_VAL;
+    for (const Vec3& v : polygon.vertices()) most = std::max(most, plane.signed_distance(v));
+    return most;
+}
+
+/// The smallest signed distance of a polygon's vertices from `plane` (negative behind).
+double lowest_below(const Polygon& polygon, const Plane& plane) {
+    double least = HUGE_VAL;
+    for (const Vec3& v : polygon.vertices()) least = std::min(least, plane.signed_distance(v));
+    return least;
+}
+
+/// Whether p lies inside the convex solid grown by `by` (behind every face's plane, and the
+/// missing face's).
+bool inside_solid(const ConvexSolid& solid, Vec3 p, double by) {
+    for (const Plane& f : solid.faces)
+        if (f.signed_distance(p) > by) return false;
+    return !solid.open || solid.missing.signed_distance(p) <= by;
+}
+
+/// Whether a point of `receiver` may see the back of one of the solid's faces: the polygon
+/// reaches the outer side of an open solid's missing face, or it is not wholly outside any of
+/// the solid's planes (it may enter the solid).
+bool may_enter(const ConvexSolid& solid, const Polygon& receiver, double slack) {
+    if (solid.open && highest_above(receiver, solid.missing) > -slack) return true;
+    for (const Plane& f : solid.faces)
+        if (lowest_below(receiver, f) > slack) return false;
+    return !solid.open || lowest_below(receiver, solid.missing) <= slack;
+}
+
+Box3 grown_box(Box3 box, double by) {
+    box.lo = box.lo - Vec3{by, by, by};
+    box.hi = box.hi + Vec3{by, by, by};
+    return box;
+}
+
+}  // namespace
+
 double contact_reach(const Polygon& occluder) {
     return occluder.diameter() > 0
                ? hidden_contact_reach * occluder.area() / occluder.diameter()
@@ -84,7 +127,9 @@ int hidden_texels(double size, double scene_size) {
 }
 
 HiddenMask find_hidden(const Surface& surface, int surface_id, const Octree& octree,
-                       const std::vector<int>* occluders) {
+                       const HiddenContacts* contacts) {
+    const std::vector<int>* occluders =
+        contacts ? &contacts->occluders[size_t(surface_id)] : nullptr;
     const Box3 box = octree.bounds();
     const double scale = box.empty() ? 1.0 : length(box.extent());
     const double slack = 1e-7 * scale;  // find_contact_occluders' "in front" and "behind"
@@ -99,6 +144,13 @@ HiddenMask find_hidden(const Surface& surface, int surface_id, const Octree& oct
         for (int o : *occluders) {
             const Polygon& occluder = polygons[size_t(o)];
             if (occluder.plane().signed_distance(p) >= -slack) continue;
+            const int k = contacts->solids.solid_of[size_t(o)];
+            if (k >= 0) {
+                const ConvexSolid& solid = contacts->solids.solids[size_t(k)];
+                if (inside_solid(solid, p, texel + slack)) return true;
+                // Outside, only an open solid's back faces show, through the missing face.
+                if (!solid.open || solid.missing.signed_distance(p) < -(texel + slack)) continue;
+            }
             const double reach = contact_reach(occluder) + texel + slack;
             const Box3 b = occluder.bounds();
             if (p.x >= b.lo.x - reach && p.x <= b.hi.x + reach && p.y >= b.lo.y - reach &&
@@ -174,32 +226,12 @@ HiddenMask find_hidden(const Surface& surface, int surface_id, const Octree& oct
     return HiddenMask(n, std::move(hidden));
 }
 
-namespace {
 
-/// The largest signed distance of a polygon's vertices from `plane` (positive in front).
-double highest_above(const Polygon& polygon, const Plane& plane) {
-    double most = -HUGE_VAL;
-    for (const Vec3& v : polygon.vertices()) most = std::max(most, plane.signed_distance(v));
-    return most;
-}
-
-/// The smallest signed distance of a polygon's vertices from `plane` (negative behind).
-double lowest_below(const Polygon& polygon, const Plane& plane) {
-    double least = HUGE_VAL;
-    for (const Vec3& v : polygon.vertices()) least = std::min(least, plane.signed_distance(v));
-    return least;
-}
-
-Box3 grown_box(Box3 box, double by) {
-    box.lo = box.lo - Vec3{by, by, by};
-    box.hi = box.hi + Vec3{by, by, by};
-    return box;
-}
-
-}  // namespace
-
-std::vector<std::vector<int>> find_contact_occluders(const Octree& octree, int n_surfaces) {
+HiddenContacts find_contacts(const Octree& octree, int n_surfaces) {
     MBR_CHECK(n_surfaces >= 0);
+    HiddenContacts contacts;
+    contacts.solids = find_convex_solids(octree.polygons());
+    const ConvexSolids& solids = contacts.solids;
     const std::vector<Polygon>& polygons = octree.polygons();
     const Box3 scene = octree.bounds();
     const double scale = scene.empty() ? 1.0 : length(scene.extent());
@@ -239,17 +271,22 @@ std::vector<std::vector<int>> find_contact_occluders(const Octree& octree, int n
             if (s < 0 || s >= n_surfaces) continue;
             if (s == occluder.surface() && !curved[size_t(s)]) continue;
             if (!overlaps(receiver.bounds(), reach)) continue;
-            if (highest_above(occluder, receiver.plane()) > slack &&
-                lowest_below(receiver, occluder.plane()) < -slack)
-                out.push_back(s);
+            if (!(highest_above(occluder, receiver.plane()) > slack &&
+                  lowest_below(receiver, occluder.plane()) < -slack))
+                continue;
+            // A face of a convex solid shows its back only inside the solid, or through an
+            // open solid's missing face.
+            const int k = solids.solid_of[size_t(p)];
+            if (k >= 0 && !may_enter(solids.solids[size_t(k)], receiver, slack)) continue;
+            out.push_back(s);
         }
         std::sort(out.begin(), out.end());
         out.erase(std::unique(out.begin(), out.end()), out.end());
     });
-    std::vector<std::vector<int>> result(static_cast<size_t>(n_surfaces));
+    contacts.occluders.resize(static_cast<size_t>(n_surfaces));
     for (int p = 0; p < int(polygons.size()); ++p)
-        for (int s : touched[size_t(p)]) result[size_t(s)].push_back(p);
-    return result;
+        for (int s : touched[size_t(p)]) contacts.occluders[size_t(s)].push_back(p);
+    return contacts;
 }
 
 }  // namespace mbr

@@ -13,6 +13,7 @@
 #include "math/vec3.h"
 #include "octree/octree.h"
 #include "radiosity/geometry/surface.h"
+#include "radiosity/visibility/convex_solids.h"
 
 namespace mbr {
 
@@ -41,6 +42,13 @@ private:
     std::vector<Vec2> substitute_;  // per texel (its own centre when visible)
 };
 
+/// What find_contacts finds: the polygons in contact with each surface, and the scene's convex
+/// solids (whose faces show their backs only from inside, or through a missing face).
+struct HiddenContacts {
+    ConvexSolids solids;
+    std::vector<std::vector<int>> occluders;  // per surface: polygon indices, increasing
+};
+
 /// The hidden-region test's constants.
 constexpr int hidden_resolution = 64;            // texels along each parameter direction, at most
 constexpr int hidden_min_resolution = 4;         //   and at least
@@ -66,13 +74,14 @@ int hidden_texels(double size, double scene_size);
 /// is known (the first visible ray among the first 4, the second among the rest). Rays are
 /// seeded from the surface and the texel (reproducible, thread-count independent).
 ///
-/// With `occluders` (the surface's list from find_contact_occluders, at most
-/// hidden_max_seed_occluders of them) only some texels cast rays: the seeds, whose centres lie
-/// behind an occluder and within its reach (contact_reach) and a texel, then, wave after wave,
-/// the neighbours of the texels found hidden. Every other texel is visible. Without (or with a
-/// longer list), every texel casts its rays.
+/// With `contacts` (find_contacts; the surface's occluder list at most
+/// hidden_max_seed_occluders long) only some texels cast rays: the seeds, whose centres lie
+/// behind an occluder and within its reach (contact_reach) and a texel, or, for a face of a
+/// convex solid, inside the solid grown by a texel (or beyond an open solid's missing face),
+/// then, wave after wave, the neighbours of the texels found hidden. Every other texel is
+/// visible. Without contacts (or with a longer list), every texel casts its rays.
 HiddenMask find_hidden(const Surface& surface, int surface_id, const Octree& octree,
-                       const std::vector<int>* occluders = nullptr);
+                       const HiddenContacts* contacts = nullptr);
 
 /// How near a polygon must come to a point to hide it, over the polygon's width (its area over
 /// its diameter: a rectangle's short side, 0.71 of a square's): contact_reach. Under the middle
@@ -97,11 +106,12 @@ constexpr int hidden_max_seed_occluders = 256;
 /// other surface; of Q's own too when Q is curved) comes within contact_reach(P) of one of
 /// Q's polygons (boxes), reaches in front of that polygon's plane, and the polygon has part of
 /// it behind P's plane: the configuration in which Q's points see P's back (the floor under a
-/// resting block, a ceiling above a one-sided lamp hung near it, a face sunk into another). A
-/// surface with an empty list (nothing touches it from in front) sees no polygon's back
-/// nearby: its points see front faces or the open scene, or lie wholly inside an enclosure
-/// that no light enters, where a mask changes nothing. Returns `n_surfaces` lists of polygon
-/// indices, increasing.
-std::vector<std::vector<int>> find_contact_occluders(const Octree& octree, int n_surfaces);
+/// resting block, a ceiling above a one-sided lamp hung near it, a face sunk into another).
+/// When P is a face of a convex solid (convex_solids.h), Q's polygon must also enter the solid
+/// or, for an open solid, reach the outer side of its missing face: from anywhere else the
+/// solid shows only its fronts (the faces of the neighbouring block). A surface with an empty
+/// list sees no polygon's back nearby: its points see front faces or the open scene, or lie
+/// wholly inside an enclosure that no light enters, where a mask changes nothing.
+HiddenContacts find_contacts(const Octree& octree, int n_surfaces);
 
 }  // namespace mbr
