@@ -184,7 +184,9 @@ public:
     void on_transfer(std::function<void(int done, int total)> f) { on_transfer_ = std::move(f); }
     /// The fields so far.
     const Solution& solution() const { return solution_; }
-    /// The fields so far, with run statistics filled (seconds, memory, coefficients).
+    /// The fields so far, with run statistics filled (seconds, memory, coefficients) and the
+    /// ambient correction added. Call it last: the fields move into the result, and the solver
+    /// is left without them (solution() is empty after).
     Solution finish();
     /// The scene's radiosity scale: emitted power (the largest channel) / total area.
     double radiosity_scale() const { return radiosity_scale_; }
