@@ -36,11 +36,12 @@
 //         on two shared cores; before name look-ups were hashed, parsing took 163 s). Ray rates
 //         fall slowly with N (about 3x from 1,000 to 200,000 quads: deeper trees, more cache
 //         misses).
-//         --solve-shots 3 (no shadows, two shared cores): 100, 300, 1000 quads take 1.3, 7.6,
-//         20 s in the shots (208, 618, 2034 transfers; kernel evaluations per transfer rise
-//         from 0.3 to 0.8 million up to 300 quads, then stay flat: the shots are linear once the
-//         floor's shooter partition is at its finest level) and 1.3, 6.7, 25 s in the setup
-//         (growing as N^1.3: the hidden-region masks). Shadows multiply the shot cost: 100
+//         --solve-shots 2 (no shadows, two cores): 1000, 3000, 10000 quads take 11.2, 42.8,
+//         237 s in the shots (1199, 3549, 11755 transfers; 1.9, 2.7, 4.7 million kernel
+//         evaluations per transfer: the second shot is the floor's, and every block face's
+//         samples integrate over a floor that grows with N) and a small setup (the hidden
+//         regions are found through the octree's contacts: 0.02 s at 1000 quads, 0.06 s at
+//         10000; docs/method.md, "Scaling with the scene"). Shadows multiply the shot cost: 100
 //         quads, 2 shots take 3 s without, 84 s with paper shadows and over 5 minutes exact.
 #include <unistd.h>
 
