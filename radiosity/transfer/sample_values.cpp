@@ -512,7 +512,8 @@ Rgb IncrementIntegrator::cell_value(const SurfacePoint& p, const QuadCell& cell,
         unoccluded += F * q.e;
         // The segment between the two true surfaces, tested as the paper's shadow rays are: one
         // by one against the shaft's list, through the octree beyond max_shaft_occluders.
-        if (segment_blocked(*occlusion_, local_, p.position, q.x, &rays_, max_shaft_occluders)) {
+        if (segment_blocked(*occlusion_, local_, p.position, q.x, &rays_, max_shaft_occluders,
+                            &recent_blockers_)) {
             ++n_blocked;
             continue;
         }

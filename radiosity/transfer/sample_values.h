@@ -248,6 +248,7 @@ private:
     long rays_ = 0;                        // rays cast for the current point
     Rgb b_star_;                           // the constant subtracted from B_h (zero: none)
     std::vector<int> local_;               // scratch: the occluders of one cell's shaft
+    RecentBlockers recent_blockers_;       // the last blockers of the nodes' rays, tried first
     std::vector<std::uint64_t> mixed_;     // cells whose nodes disagreed on visibility (curved), or
                                            //   cut cells above min_cut_level (planar): split
     // DESIGN: with ray visibility, a cell whose nodes disagree on visibility is split only while

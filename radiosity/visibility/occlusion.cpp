@@ -326,8 +326,19 @@ bool segment_blocked(const OcclusionContext& context, const std::vector<int>& oc
     if (n_rays) ++*n_rays;
     const Ray ray{a, b - a, 1e-9, 1 - 1e-9};
     const std::vector<Polygon>& polys = context.octree->polygons();
+    // The recent blockers first: a hit among them is a hit (the same test); the list holds
+    // every polygon that can meet the segment, so a miss there leaves the answer to the list.
+    if (recent)
+        for (int id : recent->ids)
+            if (id >= 0 && polys[size_t(id)].intersect_segment(ray)) {
+                recent->note(id);
+                return true;
+            }
     for (int id : occluders)
-        if (polys[id].intersect_segment(ray)) return true;
+        if (polys[id].intersect_segment(ray)) {
+            if (recent) recent->note(id);
+            return true;
+        }
     return false;
 }
 
