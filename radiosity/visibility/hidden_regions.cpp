@@ -97,13 +97,13 @@ bool inside_solid(const ConvexSolid& solid, Vec3 p, double by) {
 }
 
 /// Whether a point of `receiver` may see the back of one of the solid's faces: the polygon
-/// reaches the outer side of an open solid's missing face, or it is not wholly outside any of
-/// the solid's planes (it may enter the solid).
+/// reaches the outer side of an open solid's missing face (or its plane), or it is not wholly
+/// outside any of the solid's faces' planes (it may enter the solid).
 bool may_enter(const ConvexSolid& solid, const Polygon& receiver, double slack) {
     if (solid.open && highest_above(receiver, solid.missing) > -slack) return true;
     for (const Plane& f : solid.faces)
         if (lowest_below(receiver, f) > slack) return false;
-    return !solid.open || lowest_below(receiver, solid.missing) <= slack;
+    return true;  // (an open solid's missing plane: every vertex is inside it here)
 }
 
 Box3 grown_box(Box3 box, double by) {
@@ -132,7 +132,7 @@ HiddenMask find_hidden(const Surface& surface, int surface_id, const Octree& oct
         contacts ? &contacts->occluders[size_t(surface_id)] : nullptr;
     const Box3 box = octree.bounds();
     const double scale = box.empty() ? 1.0 : length(box.extent());
-    const double slack = 1e-7 * scale;  // find_contact_occluders' "in front" and "behind"
+    const double slack = 1e-7 * scale;  // find_contacts' "in front" and "behind"
     const int n = hidden_texels(length(surface.bounds().extent()), scale);
     const std::vector<Polygon>& polygons = octree.polygons();
     const bool grow = occluders && int(occluders->size()) <= hidden_max_seed_occluders;
@@ -206,8 +206,10 @@ HiddenMask find_hidden(const Surface& surface, int surface_id, const Octree& oct
     for (int k = 0; k < n * n; ++k)
         if (queued[size_t(k)]) wave.push_back(k);
     while (!wave.empty()) {
-        parallel_for(int(wave.size()),
-                     [&](int w) { hidden[size_t(wave[size_t(w)])] = texel_hidden(wave[size_t(w)]); });
+        parallel_for(int(wave.size()), [&](int w) {
+            const int k = wave[size_t(w)];
+            hidden[size_t(k)] = texel_hidden(k);
+        });
         std::vector<int> next;
         for (int k : wave) {
             if (!hidden[size_t(k)]) continue;
@@ -225,7 +227,6 @@ HiddenMask find_hidden(const Surface& surface, int surface_id, const Octree& oct
     }
     return HiddenMask(n, std::move(hidden));
 }
-
 
 HiddenContacts find_contacts(const Octree& octree, int n_surfaces) {
     MBR_CHECK(n_surfaces >= 0);
@@ -259,8 +260,7 @@ HiddenContacts find_contacts(const Octree& octree, int n_surfaces) {
     std::vector<std::vector<int>> touched(polygons.size());
     parallel_for(int(polygons.size()), [&](int p) {
         const Polygon& occluder = polygons[size_t(p)];
-        const Box3 reach =
-            grown_box(occluder.bounds(), contact_reach(occluder) + slack);
+        const Box3 reach = grown_box(occluder.bounds(), contact_reach(occluder) + slack);
         std::vector<int> near;
         octree.append_polygons_near([&](const Box3& cube) { return overlaps(cube, reach); }, near);
         std::vector<int>& out = touched[size_t(p)];
