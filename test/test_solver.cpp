@@ -699,6 +699,60 @@ TEST_CASE("hidden regions: the octree's contacts find every hidden texel that ra
     CHECK_FALSE(floor.hidden(0.125, 0.5));
 }
 
+TEST_CASE("hidden regions: a hidden region far from every contact grows from its rim",
+          "[solver][hidden]") {
+    // A tent on a floor: a 2 x 2 top of 8 x 8 quads 0.3 above it and four skirts down to it
+    // (68 faces: no convex solid, which would seed every texel under it). The top's quads are
+    // too narrow to reach the floor, so only texels near the skirts are seeds; the middle of
+    // the footprint, 1 from every skirt, is found by growing the hidden region.
+    std::ostringstream text;
+    text << "material white reflectance 0.5 0.5 0.5\n"
+            "rectangle floor white -2 0 -2  0 0 4  4 0 0\n";
+    const double h = 0.3;
+    for (int i = 0; i < 8; ++i)
+        for (int j = 0; j < 8; ++j) {
+            const double x0 = -1 + 0.25 * i, x1 = x0 + 0.25, z0 = -1 + 0.25 * j, z1 = z0 + 0.25;
+            text << "quad top" << i << "_" << j << " white " << x0 << ' ' << h << ' ' << z0 << "  "
+                 << x0 << ' ' << h << ' ' << z1 << "  " << x1 << ' ' << h << ' ' << z1 << "  "
+                 << x1 << ' ' << h << ' ' << z0 << "\n";
+        }
+    text << "quad skirt_x0 white -1 0 -1  -1 0 1  -1 0.3 1  -1 0.3 -1\n"
+            "quad skirt_x1 white 1 0 -1  1 0.3 -1  1 0.3 1  1 0 1\n"
+            "quad skirt_z0 white -1 0 -1  -1 0.3 -1  1 0.3 -1  1 0 -1\n"
+            "quad skirt_z1 white -1 0 1  1 0 1  1 0.3 1  -1 0.3 1\n";
+    const Scene scene = scene_from(text.str());
+    const Octree octree = build_octree(scene);
+    const int n = int(scene.surfaces.size());
+    const HiddenContacts contacts = find_contacts(octree, n);
+    const int floor_id = scene.find_surface("floor");
+    const std::vector<int>& listed = contacts.occluders[size_t(floor_id)];
+    REQUIRE_FALSE(listed.empty());
+    const Surface& floor_surface = scene.surfaces[size_t(floor_id)].surface;
+    const HiddenMask full = find_hidden(floor_surface, floor_id, octree);
+    const HiddenMask grown = find_hidden(floor_surface, floor_id, octree, &contacts);
+    // (s, t) = ((z + 2) / 4, (x + 2) / 4): the footprint's centre (0, 0, 0) is hidden, and it
+    // is out of reach of every listed polygon (no seed there).
+    CHECK(full.hidden(0.5, 0.5));
+    CHECK(grown.hidden(0.5, 0.5));
+    const double texel = length(floor_surface.bounds().extent()) / full.resolution();
+    for (int id : listed) {
+        const Polygon& polygon = octree.polygons()[size_t(id)];
+        const double reach = contact_reach(polygon) + texel;
+        const Box3 b = polygon.bounds();
+        CAPTURE(scene.surfaces[size_t(polygon.surface())].name, reach);
+        CHECK((b.lo.x - reach > 0 || b.hi.x + reach < 0 || b.lo.z - reach > 0 ||
+               b.hi.z + reach < 0 || b.lo.y - reach > 0));
+    }
+    const int r = full.resolution();
+    long differ = 0;
+    for (int j = 0; j < r; ++j)
+        for (int k = 0; k < r; ++k)
+            differ += full.hidden((k + 0.5) / r, (j + 0.5) / r) !=
+                      grown.hidden((k + 0.5) / r, (j + 0.5) / r);
+    CHECK(full.hidden_count() > 200);
+    CHECK(differ == 0);
+}
+
 TEST_CASE("shadows auto: exact between few occluding surfaces, the paper's between many",
           "[solver][shadows]") {
     // A lamp above a floor with n small boxes between them (six surfaces each): the lamp-to-
