@@ -101,6 +101,15 @@ Rgb extrapolate_side(const ReceiverState& state, int e, const EdgeValue& at_foot
     return phi0 * at_foot.v + (w * phi1) * d_out;
 }
 
+SidePatch side_patch(double s, double t) {
+    const int si = s < 0 ? -1 : (s > 1 ? 1 : 0);
+    const int ti = t < 0 ? -1 : (t > 1 ? 1 : 0);
+    const int e = ti < 0 ? 0 : (si > 0 ? 1 : (ti > 0 ? 2 : 3));
+    const double foot = (e == 0 || e == 2) ? s : t;
+    const double offset = e == 0 ? t : (e == 1 ? s - 1 : (e == 2 ? t - 1 : s));
+    return {e, foot, offset};
+}
+
 CornerValue corner_value(const ReceiverState& state, double s_c, double t_c) {
     const EdgeProfile& horizontal = state.edges[t_c < 0.5 ? 0 : 2];  // carries d/dt there
     const EdgeProfile& vertical = state.edges[s_c > 0.5 ? 1 : 3];    // carries d/ds there
@@ -135,10 +144,8 @@ Rgb extrapolate(const ReceiverState& state, double s, double t) {
     if (si == 0 || ti == 0) {
         // Patches 1, 3, 5, 7: along the edge normal, eq. (23) or (26)/(27), from the edge's
         // value at the point's foot, at its signed offset (t - c or s - b) from the edge.
-        const int e = ti < 0 ? 0 : (si > 0 ? 1 : (ti > 0 ? 2 : 3));
-        const double offset = e == 0 ? t : (e == 1 ? s - 1 : (e == 2 ? t - 1 : s));
-        return extrapolate_side(state, e, edge_value(state, e, (e == 0 || e == 2) ? s : t),
-                                offset);
+        const SidePatch side = side_patch(s, t);
+        return extrapolate_side(state, side.e, edge_value(state, side.e, side.foot), side.offset);
     }
     // Patches 0, 2, 4, 6: from the corner (s_c, t_c), eqs. (24)-(25) or the tensor form.
     return extrapolate_corner(state, corner_value(state, si > 0 ? 1 : 0, ti > 0 ? 1 : 0), s, t);

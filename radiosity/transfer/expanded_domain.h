@@ -23,6 +23,14 @@ EdgeValue edge_value(const ReceiverState& state, int e, double sigma);
 /// the point's foot, `offset` the point's signed distance from the edge along its normal
 /// coordinate (t, s - 1, t - 1 or s): eq. (23), or (26)/(27).
 Rgb extrapolate_side(const ReceiverState& state, int e, const EdgeValue& at_foot, double offset);
+/// The side patch (1, 3, 5 or 7) that (s, t) lies in, outside [0,1]^2 beside one edge only:
+/// the edge e, the point's foot on it (s on edges 0 and 2, t on 1 and 3) and its signed offset
+/// from the edge along the normal coordinate (t, s - 1, t - 1 or s).
+struct SidePatch {
+    int e;
+    double foot, offset;
+};
+SidePatch side_patch(double s, double t);
 /// extrapolate() on the corner patch of corner (s_c, t_c) (patches 0, 2, 4, 6), from the value
 /// and clamped derivatives there: eqs. (24)-(25), or the tensor form.
 struct CornerValue {

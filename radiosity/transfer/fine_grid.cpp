@@ -59,9 +59,9 @@ void fill_node_values(const ReceiverState& state, const ProjectionTables& tables
         const double s = coordinate[size_t(ka)], t = coordinate[size_t(kb)];
         const int si = s < 0 ? -1 : (s > 1 ? 1 : 0), ti = t < 0 ? -1 : (t > 1 ? 1 : 0);
         if (si != 0 && ti != 0) return extrapolate_corner(state, corner[si > 0][ti > 0], s, t);
-        const int e = ti < 0 ? 0 : (si > 0 ? 1 : (ti > 0 ? 2 : 3));
-        const double offset = e == 0 ? t : (e == 1 ? s - 1 : (e == 2 ? t - 1 : s));
-        return extrapolate_side(state, e, at_foot[e][size_t(e == 0 || e == 2 ? ka : kb)], offset);
+        const SidePatch side = side_patch(s, t);
+        const int foot = side.e == 0 || side.e == 2 ? ka : kb;  // the foot's node index
+        return extrapolate_side(state, side.e, at_foot[side.e][size_t(foot)], side.offset);
     };
     parallel_for(grid.n_cells, [&](int jj) {
         const int j = lo + jj;
