@@ -10,6 +10,7 @@
 #include <cstdlib>
 #include <limits>
 #include <mutex>
+#include <optional>
 #include <set>
 #include <stdexcept>
 
@@ -384,22 +385,25 @@ ProgressiveSolver::ProgressiveSolver(const Scene& scene, const Octree& octree,
     shot_power_.assign(n, Rgb{});
     last_seconds_.assign(n, 0.0);
     weights_.resize(n);
-    // DESIGN: exact visibility projects each convex solid of the scene's polygons (a block, a
-    // table top) as one silhouette instead of face by face (convex_solids.h; docs/method.md).
-    if (options.receiver.shadows.method == ShadowMethod::Exact)
-        solids_ = std::make_unique<ConvexSolids>(find_convex_solids(octree.polygons()));
     hidden_.resize(n);
+    std::optional<HiddenContacts> contacts;
     if (options.hidden_regions) {
         // DESIGN: only the surfaces that another polygon touches from in front can hold a
         // hidden region, and only near those polygons (find_contacts); the others keep an
         // empty mask.
-        const HiddenContacts contacts = find_contacts(octree, n);
+        contacts = find_contacts(octree, n);
         for (int i = 0; i < n; ++i) {
-            if (!contacts.occluders[size_t(i)].empty())  // parallel inside
-                hidden_[i] = find_hidden(scene.surfaces[i].surface, i, octree, &contacts);
+            if (!contacts->occluders[size_t(i)].empty())  // parallel inside
+                hidden_[i] = find_hidden(scene.surfaces[i].surface, i, octree, &*contacts);
             if (on_setup) on_setup(i + 1, n);
         }
     }
+    // DESIGN: exact visibility projects each convex solid of the scene's polygons (a block, a
+    // table top) as one silhouette instead of face by face (convex_solids.h; docs/method.md).
+    // find_contacts has found them already when the hidden regions are on.
+    if (options.receiver.shadows.method == ShadowMethod::Exact)
+        solids_ = std::make_unique<ConvexSolids>(contacts ? std::move(contacts->solids)
+                                                          : find_convex_solids(octree.polygons()));
     // "for each emitting surface L_i compute the projection of its emittance distribution".
     double emitted = 0;
     Rgb emitted_rgb;
