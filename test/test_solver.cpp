@@ -635,6 +635,19 @@ TEST_CASE("hidden regions: texels no smaller than 1/2048 of the scene, 4 to 64 a
     }
 }
 
+namespace {
+/// The texels of `full`'s grid (its resolution a side) whose centres `other` marks otherwise.
+long texels_differing(const HiddenMask& full, const HiddenMask& other) {
+    const int r = full.resolution();
+    long differ = 0;
+    for (int j = 0; j < r; ++j)
+        for (int k = 0; k < r; ++k)
+            differ += full.hidden((k + 0.5) / r, (j + 0.5) / r) !=
+                      other.hidden((k + 0.5) / r, (j + 0.5) / r);
+    return differ;
+}
+}  // namespace
+
 TEST_CASE("hidden regions: the octree's contacts find every hidden texel that rays from all "
           "texels find",
           "[solver][hidden]") {
@@ -678,14 +691,8 @@ TEST_CASE("hidden regions: the octree's contacts find every hidden texel that ra
                                         : find_hidden(surface, i, octree, &contacts);
         hidden_texels += full.hidden_count();
         filtered_texels += filtered.hidden_count();
-        const int r = full.resolution();
-        long differ = 0;
-        for (int j = 0; j < r; ++j)
-            for (int k = 0; k < r; ++k)
-                differ += full.hidden((k + 0.5) / r, (j + 0.5) / r) !=
-                          filtered.hidden((k + 0.5) / r, (j + 0.5) / r);
         CAPTURE(scene.surfaces[size_t(i)].name, full.hidden_count(), filtered.hidden_count());
-        CHECK(differ == 0);
+        CHECK(texels_differing(full, filtered) == 0);
     }
     test::report() << "contacts: " << hidden_texels << " hidden texels by every texel's rays, "
                    << filtered_texels << " through the contacts\n";
@@ -743,14 +750,8 @@ TEST_CASE("hidden regions: a hidden region far from every contact grows from its
         CHECK((b.lo.x - reach > 0 || b.hi.x + reach < 0 || b.lo.z - reach > 0 ||
                b.hi.z + reach < 0 || b.lo.y - reach > 0));
     }
-    const int r = full.resolution();
-    long differ = 0;
-    for (int j = 0; j < r; ++j)
-        for (int k = 0; k < r; ++k)
-            differ += full.hidden((k + 0.5) / r, (j + 0.5) / r) !=
-                      grown.hidden((k + 0.5) / r, (j + 0.5) / r);
     CHECK(full.hidden_count() > 200);
-    CHECK(differ == 0);
+    CHECK(texels_differing(full, grown) == 0);
 }
 
 TEST_CASE("shadows auto: exact between few occluding surfaces, the paper's between many",
