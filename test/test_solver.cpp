@@ -196,6 +196,32 @@ std::vector<double> lowest_values(const Scene& given, bool limiter,
 
 }  // namespace
 
+TEST_CASE("solver: a planar quad's separable power weights equal the cell-by-cell rule",
+          "[solver]") {
+    // A trapezoid (A varies along both parameters), a parallelogram, and its reverse: the
+    // separable moments against (m + 2)-point Gauss over every cell of [0,1]^2, and both
+    // against the area (the weights of a partition of unity sum to it).
+    const Surface trapezoid =
+        Surface::planar_quad({0, 0, 0}, {3, 0, 0}, {2, 0.5, 1.5}, {0.5, 0.5, 1.5});
+    const Surface parallelogram = Surface::planar_quad({1, 2, 0}, {3, 2, 1}, {3, 4, 1}, {1, 4, 0});
+    for (const Surface& surface : {trapezoid, parallelogram, trapezoid.reversed()})
+        for (int m : {2, 3, 4})
+            for (int level : {0, 1, 3, 5}) {
+                const std::vector<double> fast = area_weights(surface, m, level);
+                const std::vector<double> reference = area_weights_by_cells(surface, m, level);
+                REQUIRE(fast.size() == reference.size());
+                double largest = 0, worst = 0, sum = 0;
+                for (size_t i = 0; i < fast.size(); ++i) {
+                    largest = std::max(largest, std::fabs(reference[i]));
+                    worst = std::max(worst, std::fabs(fast[i] - reference[i]));
+                    sum += fast[i];
+                }
+                INFO("m " << m << " level " << level);
+                CHECK(worst <= 1e-12 * largest);
+                CHECK(sum == Approx(surface.area()).epsilon(1e-12));
+            }
+}
+
 TEST_CASE("solver: radiosity is never negative or NaN", "[solver]") {
     // A floating block casts an umbra (where the light's increment is exactly zero) ringed by
     // penumbrae on the floor, and a lit wall meets the floor. At max_depth 3 this umbra rings

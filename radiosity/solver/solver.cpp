@@ -356,6 +356,69 @@ RadiosityView radiosity_view(const Scene& scene, const Solution& solution) {
     return RadiosityView(std::move(surfaces), std::move(positive));
 }
 
+std::vector<double> area_weights_by_cells(const Surface& S, int m, int level) {
+    // w_kl = int int N_m(2^j s - k) N_m(2^j t - l) A(s, t) ds dt, by (m + 2)-point Gauss per
+    // cell: exact for planar quads (A is linear in s and t), accurate for curved surfaces.
+    const int first = first_touching_index(m), n = touching_count(m, level), cells = 1 << level;
+    const GaussLegendre rule = gauss_legendre(m + 2);
+    std::vector<double> w(size_t(n) * n, 0.0);
+    double vs[16], vt[16];
+    for (int ci = 0; ci < cells; ++ci)
+        for (int qa = 0; qa < rule.n(); ++qa) {
+            const double s = (ci + 0.5 * (rule.x[qa] + 1)) / cells;
+            const int fk = bspline_values(m, std::ldexp(s, level), vs);
+            for (int cj = 0; cj < cells; ++cj)
+                for (int qb = 0; qb < rule.n(); ++qb) {
+                    const double t = (cj + 0.5 * (rule.x[qb] + 1)) / cells;
+                    const int fl = bspline_values(m, std::ldexp(t, level), vt);
+                    const double a = 0.25 * rule.w[qa] * rule.w[qb] / (double(cells) * cells) *
+                                     S.area_factor(s, t);
+                    for (int p = 0; p < m; ++p)
+                        for (int q = 0; q < m; ++q) {
+                            const int k = fk + p - first, l = fl + q - first;
+                            if (k >= 0 && k < n && l >= 0 && l < n)
+                                w[size_t(k) * n + l] += a * vs[p] * vt[q];
+                        }
+                }
+        }
+    return w;
+}
+
+std::vector<double> area_weights(const Surface& S, int m, int level) {
+    if (S.kind() != Surface::Kind::PlanarQuad) return area_weights_by_cells(S, m, level);
+    // DESIGN: on a planar quad x_s x x_t = e1 x e2 + s (e1 x d) + t (d x e2) with e1, e2 its
+    // edges from x(0,0) and d = x(1,1) - x(1,0) - x(0,1) + x(0,0), all three along the plane's
+    // normal: A(s, t) is linear, and equals the bilinear interpolant of its corner values. With
+    // J0_k = int (1 - s) N_k(s) ds and J1_k = int s N_k(s) ds (by (m + 2)-point Gauss per cell,
+    // exact), w_kl = A00 J0_k J0_l + A10 J1_k J0_l + A01 J0_k J1_l + A11 J1_k J1_l: n^2 terms
+    // instead of 36 m^2 4^j products (the solver's power() at 100,000 quads, level 7).
+    const int first = first_touching_index(m), n = touching_count(m, level), cells = 1 << level;
+    const GaussLegendre rule = gauss_legendre(m + 2);
+    std::vector<double> j0(size_t(n), 0.0), j1(size_t(n), 0.0);
+    double v[16];
+    for (int c = 0; c < cells; ++c)
+        for (int q = 0; q < rule.n(); ++q) {
+            const double s = (c + 0.5 * (rule.x[q] + 1)) / cells;
+            const double weight = 0.5 * rule.w[q] / cells;
+            const int fk = bspline_values(m, std::ldexp(s, level), v);
+            for (int p = 0; p < m; ++p) {
+                const int k = fk + p - first;
+                if (k < 0 || k >= n) continue;
+                j0[size_t(k)] += weight * (1 - s) * v[p];
+                j1[size_t(k)] += weight * s * v[p];
+            }
+        }
+    const double a00 = S.area_factor(0, 0), a10 = S.area_factor(1, 0), a01 = S.area_factor(0, 1),
+                 a11 = S.area_factor(1, 1);
+    std::vector<double> w(size_t(n) * n);
+    for (int k = 0; k < n; ++k)
+        for (int l = 0; l < n; ++l)
+            w[size_t(k) * n + l] =
+                a00 * j0[size_t(k)] * j0[size_t(l)] + a10 * j1[size_t(k)] * j0[size_t(l)] +
+                a01 * j0[size_t(k)] * j1[size_t(l)] + a11 * j1[size_t(k)] * j1[size_t(l)];
+    return w;
+}
+
 // ---- The loop -----------------------------------------------------------------------------
 
 ProgressiveSolver::ProgressiveSolver(const Scene& scene, const Octree& octree,
@@ -438,33 +501,7 @@ const std::vector<double>& ProgressiveSolver::power_weights(int surface, int lev
     std::vector<std::vector<double>>& cache = weights_[surface];
     if (int(cache.size()) <= level) cache.resize(level + 1);
     std::vector<double>& w = cache[level];
-    if (!w.empty()) return w;
-    // w_kl = int int N_m(2^j s - k) N_m(2^j t - l) A(s, t) ds dt, by (m + 2)-point Gauss per
-    // cell: exact for planar quads (A is linear in s and t), accurate for curved surfaces.
-    const int m = order_[surface];
-    const int first = first_touching_index(m), n = touching_count(m, level), cells = 1 << level;
-    const GaussLegendre rule = gauss_legendre(m + 2);
-    const Surface& S = scene_.surfaces[surface].surface;
-    w.assign(size_t(n) * n, 0.0);
-    double vs[16], vt[16];
-    for (int ci = 0; ci < cells; ++ci)
-        for (int qa = 0; qa < rule.n(); ++qa) {
-            const double s = (ci + 0.5 * (rule.x[qa] + 1)) / cells;
-            const int fk = bspline_values(m, std::ldexp(s, level), vs);
-            for (int cj = 0; cj < cells; ++cj)
-                for (int qb = 0; qb < rule.n(); ++qb) {
-                    const double t = (cj + 0.5 * (rule.x[qb] + 1)) / cells;
-                    const int fl = bspline_values(m, std::ldexp(t, level), vt);
-                    const double a = 0.25 * rule.w[qa] * rule.w[qb] / (double(cells) * cells) *
-                                     S.area_factor(s, t);
-                    for (int p = 0; p < m; ++p)
-                        for (int q = 0; q < m; ++q) {
-                            const int k = fk + p - first, l = fl + q - first;
-                            if (k >= 0 && k < n && l >= 0 && l < n)
-                                w[size_t(k) * n + l] += a * vs[p] * vt[q];
-                        }
-                }
-        }
+    if (w.empty()) w = area_weights(scene_.surfaces[surface].surface, order_[surface], level);
     return w;
 }
 

@@ -160,6 +160,15 @@ Rgb coefficient_bound(const SplineField& field);
 /// limit_positive; the solution is unchanged.
 RadiosityView radiosity_view(const Scene& scene, const Solution& solution);
 
+/// The power weights of a surface's fields of order m at `level`: w[k * n + l] = int int
+/// N_m(2^j s - k) N_m(2^j t - l) A(s, t) ds dt over [0,1]^2 (A the area factor (4); k, l over
+/// the n touching indices from first_touching_index), so that int B A = sum_kl c_kl w_kl. On a
+/// planar quad A is linear in s and t and the weights separate into one-dimensional moments
+/// (O(n^2)); on other surfaces (m + 2)-point Gauss per cell in both directions.
+std::vector<double> area_weights(const Surface& surface, int m, int level);
+/// The same by the two-dimensional rule on every surface (the reference of area_weights).
+std::vector<double> area_weights_by_cells(const Surface& surface, int m, int level);
+
 /// True when surface i of `scene` stores H under `options` (a textured reflectance with
 /// irradiance_fields on).
 bool stores_irradiance(const Scene& scene, int surface, const SolverOptions& options);
