@@ -10,6 +10,7 @@
 #include <thread>
 
 #include "examples/common/progress.h"
+#include "examples/common/scene_cli.h"
 #include "test/run_program.h"
 
 using Catch::Matchers::Contains;
@@ -83,4 +84,20 @@ TEST_CASE("progress: the time left in seconds, minutes or hours", "[progress]") 
     CHECK(mbr::format_duration(2322) == "39 min");
     CHECK(mbr::format_duration(7199) == "120 min");
     CHECK(mbr::format_duration(12600) == "3.5 h");
+}
+
+TEST_CASE("progress: the shots' fraction reaches 1 only when the run ends", "[progress]") {
+    using mbr::shot_progress_fraction;
+    // With a convergence threshold: the unshot share's way down to it, on a log scale.
+    CHECK(shot_progress_fraction(1.0, 1e-3, 0, 100) == 0.0);
+    CHECK(shot_progress_fraction(0.1, 1e-3, 5, 100) == Approx(1.0 / 3));
+    CHECK(shot_progress_fraction(1e-4, 1e-3, 50, 100) == 1.0);
+    CHECK(shot_progress_fraction(0.0, 1e-3, 50, 100) == 1.0);
+    CHECK(shot_progress_fraction(1.3, 1e-3, 1, 100) == 0.0);  // more unshot than emitted
+    // Without one (--convergence 0) only the shot limit ends the run: before, every update of
+    // every shot read 1 and was printed at once, a line per receiver off a terminal.
+    CHECK(shot_progress_fraction(0.5, 0.0, 0, 4) == 0.0);
+    CHECK(shot_progress_fraction(0.5, 0.0, 3, 4) == 0.75);
+    CHECK(shot_progress_fraction(0.5, 0.0, 4, 4) == 1.0);
+    CHECK(shot_progress_fraction(0.5, 0.0, 0, 0) == 1.0);
 }

@@ -333,10 +333,7 @@ struct ShotProgress {
     double elapsed = 0;       // seconds of the shots so far
     double shot_start = 0;    // now_seconds() when the shot under way began
     int done = 0, total = 0;  // its receivers done, of
-    double fraction() const {
-        return std::clamp(left > 0 && target > 0 ? std::log(left) / std::log(target) : 1.0, 0.0,
-                          1.0);
-    }
+    double fraction() const { return shot_progress_fraction(left, target, shot, max_shots); }
     /// Assumes the unshot power keeps falling geometrically to the target, and no more shots
     /// than the limit, at the mean time a shot has taken; the shot under way counts with the
     /// time its receivers so far say it will take (one slow shot among fast ones, a wall
@@ -358,6 +355,11 @@ struct ShotProgress {
 };
 
 }  // namespace
+
+double shot_progress_fraction(double left, double target, int shots, int max_shots) {
+    if (!(target > 0)) return max_shots > 0 ? std::clamp(double(shots) / max_shots, 0.0, 1.0) : 1.0;
+    return std::clamp(left > 0 ? std::log(left) / std::log(target) : 1.0, 0.0, 1.0);
+}
 
 Solution solve_scene(SceneRun& run, bool progress) {
     // A receiver too coarse for a light's peak is an error before the first shot, not a dark
@@ -388,7 +390,11 @@ Solution solve_scene(SceneRun& run, bool progress) {
             sp.elapsed = 0;
             for (const ShotStats& x : st.per_shot) sp.elapsed += x.seconds;
             sp.left = st.emitted_power > 0 ? shot.unshot_after / st.emitted_power : 0;
-            shot_stage();
+            // After the last shot the ambient correction may follow, not a "shot 4/3".
+            if (sp.shot < sp.max_shots)
+                shot_stage();
+            else
+                reporter->stage("finishing the solve (the ambient correction when on)");
         },
         [&](int done, int total) {
             if (!reporter) return;

@@ -68,6 +68,12 @@ SceneRun read_scene_run(Args& args, Scene scene, const std::string& name);
 /// regions, each shot and the receivers inside it.
 Solution solve_scene(SceneRun& run, bool progress);
 
+/// How far the shots are, for the progress bar (0..1): the unshot share `left` on its way down
+/// (geometrically) to the convergence threshold `target`; with no threshold (0: only the shot
+/// limit stops the run) the shots done of `max_shots`. 1 ends the stage, so it must not come
+/// before the run ends (off a terminal every update of a finished stage is printed at once).
+double shot_progress_fraction(double left, double target, int shots, int max_shots);
+
 /// One line per shot.
 void print_shots(std::ostream& os, const Scene& scene, const SolveStats& stats);
 /// The run's statistics as text.
