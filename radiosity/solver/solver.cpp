@@ -391,7 +391,9 @@ std::vector<double> area_weights(const Surface& S, int m, int level) {
     // normal: A(s, t) is linear, and equals the bilinear interpolant of its corner values. With
     // J0_k = int (1 - s) N_k(s) ds and J1_k = int s N_k(s) ds (by (m + 2)-point Gauss per cell,
     // exact), w_kl = A00 J0_k J0_l + A10 J1_k J0_l + A01 J0_k J1_l + A11 J1_k J1_l: n^2 terms
-    // instead of 36 m^2 4^j products (the solver's power() at 100,000 quads, level 7).
+    // instead of 36 m^2 4^j products (the solver's power() at 100,000 quads, level 7). A quad
+    // the scene format accepts as planar within its tolerance has A linear up to the square of
+    // its deviation from its plane, and so have these weights.
     const int first = first_touching_index(m), n = touching_count(m, level), cells = 1 << level;
     const GaussLegendre rule = gauss_legendre(m + 2);
     std::vector<double> j0(size_t(n), 0.0), j1(size_t(n), 0.0);
