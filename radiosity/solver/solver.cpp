@@ -340,7 +340,9 @@ RadiosityView radiosity_view(const Scene& scene, const Solution& solution) {
     std::shared_ptr<std::vector<SplineField>> positive;
     if (scene.settings.limiter) {
         positive = std::make_shared<std::vector<SplineField>>(solution.radiosity);
-        for (SplineField& f : *positive) limit_positive(f);
+        // Each field on its own, side by side (73 s of one core at 100,000 quads, serial).
+        std::vector<SplineField>& fields = *positive;
+        parallel_for(n, [&fields](int i) { limit_positive(fields[size_t(i)]); });
     }
     std::vector<ShadedField> surfaces(n);
     for (int i = 0; i < n; ++i) {
