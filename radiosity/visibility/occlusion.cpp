@@ -286,6 +286,22 @@ void group_surface_boxes(OcclusionContext& context) {
     }
 }
 
+namespace {
+
+/// Whether one of the recent blockers (none when `recent` is null) blocks the ray; the one
+/// found becomes the most recent.
+bool blocked_by_recent(RecentBlockers* recent, const std::vector<Polygon>& polys, const Ray& ray) {
+    if (!recent) return false;
+    for (int id : recent->ids)
+        if (id >= 0 && polys[size_t(id)].intersect_segment(ray)) {
+            recent->note(id);
+            return true;
+        }
+    return false;
+}
+
+}  // namespace
+
 bool segment_blocked(const OcclusionContext& context, Vec3 a, Vec3 b, long* n_rays,
                      RecentBlockers* recent) {
     if (context.candidates.empty()) return false;
@@ -297,12 +313,7 @@ bool segment_blocked(const OcclusionContext& context, Vec3 a, Vec3 b, long* n_ra
     const std::vector<Polygon>& polys = context.octree->polygons();
     // Polygons that blocked this point's rays before were found under the same rules (the
     // octree's test is Polygon::intersect_segment's on a packed copy): a hit among them is one.
-    if (recent)
-        for (int id : recent->ids)
-            if (id >= 0 && polys[size_t(id)].intersect_segment(ray)) {
-                recent->note(id);
-                return true;
-            }
+    if (blocked_by_recent(recent, polys, ray)) return true;
     int blocker = -1;
     if (context.candidates.size() <= 16) {
         for (int id : context.candidates)
@@ -328,12 +339,7 @@ bool segment_blocked(const OcclusionContext& context, const std::vector<int>& oc
     const std::vector<Polygon>& polys = context.octree->polygons();
     // The recent blockers first: a hit among them is a hit (the same test); the list holds
     // every polygon that can meet the segment, so a miss there leaves the answer to the list.
-    if (recent)
-        for (int id : recent->ids)
-            if (id >= 0 && polys[size_t(id)].intersect_segment(ray)) {
-                recent->note(id);
-                return true;
-            }
+    if (blocked_by_recent(recent, polys, ray)) return true;
     for (int id : occluders)
         if (polys[id].intersect_segment(ray)) {
             if (recent) recent->note(id);
