@@ -872,23 +872,40 @@ Solution ProgressiveSolver::finish() {
     // convergence test. Then the fields move into the result instead of being copied (the copy
     // doubled the fields' memory at the end: scene_scaling's 10,000 quads after 2 shots hold
     // 19 M coefficients a channel, 0.9 GB in the radiosity and unshot fields).
-    AmbientGather gather;
-    double gather_seconds = 0;
-    std::vector<Rgb> correction;
+    std::vector<SplineField> added;  // per surface, what the ambient correction adds
+    double ambient_power = 0, ambient_seconds = 0;
+    long ambient_rays = 0;
     if (options_.ambient && options_.ambient_rays > 0) {
+        // The unshot power and its further bounces gathered where they fall.
         std::vector<bool> irradiance;
         for (size_t i = 0; i < solution_.radiosity.size(); ++i)
             irradiance.push_back(!solution_.quantity.empty() &&
                                  solution_.quantity[i] == FieldQuantity::irradiance);
         const AmbientSources sources{solution_.unshot, order_, irradiance, hidden_};
         const double gather_start = now();
-        gather = gather_ambient(
+        AmbientGather gather = gather_ambient(
             scene_, octree_, sources, options_.ambient_rays, options_.ambient_level, 1,
             options_.ambient_final ? final_gather_share * options_.tolerance * radiosity_scale_
                                    : 0.0);
-        gather_seconds = now() - gather_start;
+        ambient_seconds = now() - gather_start;
+        added = std::move(gather.added);
+        ambient_power = gather.power;
+        ambient_rays = gather.rays;
     } else if (options_.ambient) {
-        correction = ambient_correction();
+        const std::vector<Rgb> correction = ambient_correction();
+        added.resize(correction.size());
+        for (size_t i = 0; i < correction.size(); ++i) {
+            if (max_abs(correction[i]) == 0) continue;
+            // An irradiance field takes the constant's H, correction / mean rho, so that the
+            // power added is the same and B = rho H carries the texture.
+            Rgb a = correction[i];
+            if (solution_.quantity[i] == FieldQuantity::irradiance) {
+                const Rgb rv = scene_.material_of(i).reflectance.mean();
+                for (int c = 0; c < 3; ++c) a[c] = rv[c] > 0 ? a[c] / rv[c] : 0.0;
+            }
+            added[i] = SplineField::constant(order_[i], 0, a);
+            ambient_power += channel_sum(correction[i]) * scene_.surfaces[i].surface.area();
+        }
     }
     double largest = 0;
     for (int i = 0; i < int(scene_.surfaces.size()); ++i)
@@ -896,27 +913,11 @@ Solution ProgressiveSolver::finish() {
     Solution out = std::move(solution_);
     solution_ = Solution{};
     SolveStats& st = out.stats;
-    if (options_.ambient && options_.ambient_rays > 0) {
-        // The unshot power and its further bounces gathered where they fall.
-        st.ambient_seconds = gather_seconds;
-        for (size_t i = 0; i < gather.added.size(); ++i)
-            if (!gather.added[i].empty()) out.radiosity[i].add(gather.added[i]);
-        st.ambient_power = gather.power;
-        st.ambient_rays = gather.rays;
-    } else if (options_.ambient) {
-        for (size_t i = 0; i < correction.size(); ++i) {
-            if (max_abs(correction[i]) == 0) continue;
-            // An irradiance field takes the constant's H, correction / mean rho, so that the
-            // power added is the same and B = rho H carries the texture.
-            Rgb added = correction[i];
-            if (out.quantity[i] == FieldQuantity::irradiance) {
-                const Rgb rv = scene_.material_of(i).reflectance.mean();
-                for (int c = 0; c < 3; ++c) added[c] = rv[c] > 0 ? added[c] / rv[c] : 0.0;
-            }
-            out.radiosity[i].add(SplineField::constant(order_[i], 0, added));
-            st.ambient_power += channel_sum(correction[i]) * scene_.surfaces[i].surface.area();
-        }
-    }
+    for (size_t i = 0; i < added.size(); ++i)
+        if (!added[i].empty()) out.radiosity[i].add(added[i]);
+    st.ambient_seconds = ambient_seconds;
+    st.ambient_power = ambient_power;
+    st.ambient_rays = ambient_rays;
     // NaN anywhere in a solution is an error, never an output.
     for (size_t i = 0; i < out.radiosity.size(); ++i)
         for (int c = 0; c < 3 && !out.radiosity[i].empty(); ++c)
