@@ -25,6 +25,7 @@
 #include "radiosity/scene/scene_io.h"
 #include "radiosity/solver/solution_file.h"
 #include "radiosity/solver/solver.h"
+#include "radiosity/visibility/occlusion.h"
 
 namespace {
 
@@ -39,15 +40,6 @@ const char* usage =
     "  --seed S   seed of the points (default 1)\n"
     "  --worst N  also list the N points that differ most (surface, u, v, B_a, B_b)\n"
     "  --csv      one CSV row\n";
-
-/// A uniform number in [0, 1) from a 64-bit hash of (seed, a, b) (splitmix64 finaliser).
-double uniform(std::uint64_t seed, std::uint64_t a, std::uint64_t b) {
-    std::uint64_t z = seed * 0x9e3779b97f4a7c15ULL + a * 0xbf58476d1ce4e5b9ULL + b + 1;
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-    z ^= z >> 31;
-    return double(z >> 11) * 0x1.0p-53;
-}
 
 double channel_sum(mbr::Rgb c) {
     return c.r + c.g + c.b;
@@ -77,10 +69,11 @@ int run(mbr::Args& args) {
         if (max_abs(scene.material_of(i).emission.maximum()) > 0) continue;
         const mbr::Surface& s = scene.surfaces[size_t(i)].surface;
         const double share = s.area() / k_points;
+        // The solver's own seeded hash (occlusion.h): surface i's points from key (seed, i).
+        const std::uint64_t key = mbr::hash_seed(std::uint64_t(seed), std::uint64_t(i));
         for (int k = 0; k < k_points; ++k) {
-            const double u = uniform(std::uint64_t(seed), std::uint64_t(i), 2 * std::uint64_t(k));
-            const double v =
-                uniform(std::uint64_t(seed), std::uint64_t(i), 2 * std::uint64_t(k) + 1);
+            const double u = mbr::uniform01(key, 2 * std::uint64_t(k));
+            const double v = mbr::uniform01(key, 2 * std::uint64_t(k) + 1);
             points.push_back(
                 {channel_sum(view_a.at(i, u, v)), channel_sum(view_b.at(i, u, v)), share, i, u, v});
         }
