@@ -488,6 +488,9 @@ bool Octree::test_leaf(const Node& node, Query& q) const {
         // The same polygon keeps the same answer for the same ends, so skipping repeated
         // tests stays sound.
         if (q.filter.ends_on_surfaces && !polygons_[id].hit_counts(q.ends[0], q.ends[1])) continue;
+        if (q.filter.only_polygons &&
+            !std::binary_search(q.filter.only_polygons->begin(), q.filter.only_polygons->end(), id))
+            continue;
         if (q.any) {
             q.best = id;
             return true;

@@ -97,6 +97,10 @@ struct RayFilter {
     int skip_surface_b = -1;
     bool ends_on_surfaces = false;  // the ray's ends, ray.at(t_min) and ray.at(t_max) (the first
                                     //   only when t_max is infinite), lie on true surfaces
+    /// When set, a hit on a polygon missing from this list (indices, increasing) is skipped: the
+    /// shadow rays of a pair count only the pair's occluder candidates, the same answer as
+    /// testing the list one by one (checked after the ray-polygon test: hits only).
+    const std::vector<int>* only_polygons = nullptr;
     bool skips(int surface) const { return surface == skip_surface_a || surface == skip_surface_b; }
 };
 

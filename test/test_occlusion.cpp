@@ -275,6 +275,124 @@ TEST_CASE("shadow: segment_blocked equals brute force with few and with many can
     CHECK(n_blocked < n_segments);
 }
 
+TEST_CASE("shadow: any_hit with only_polygons counts the listed polygons alone",
+          "[shadow][occlusion]") {
+    // RayFilter::only_polygons: the octree's answer must be "some listed polygon of a surface not
+    // skipped is hit in range", as a loop over the list decides; random lists of about a third
+    // of the polygons, random rays.
+    const unsigned seed = 1707;
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> u(0, 4);
+    std::uniform_int_distribution<int> surface(0, 5);
+    std::vector<Polygon> scene;
+    for (int i = 0; i < 300; ++i) {
+        const Vec3 c{u(rng), u(rng), u(rng)};
+        scene.push_back(make_polygon(
+            i % 2 ? random_parallelogram(rng, c, 0.6) : random_triangle(rng, c, 0.8), surface(rng)));
+    }
+    const Octree octree(scene, OctreeOptions{8, 4});
+    long n_hits_all = 0, n_hits_listed = 0;
+    for (int list = 0; list < 5; ++list) {
+        std::vector<int> only;
+        for (int i = 0; i < int(scene.size()); ++i)
+            if (u(rng) < 4.0 / 3) only.push_back(i);
+        RayFilter filter{list % 3, -1};
+        filter.only_polygons = &only;
+        for (int r = 0; r < 400; ++r) {
+            const Vec3 a{u(rng), u(rng), u(rng)}, b{u(rng), u(rng), u(rng)};
+            const Ray ray{a, b - a, 0, 1};
+            bool brute = false;
+            for (int id : only)
+                if (!filter.skips(scene[size_t(id)].surface()) && scene[size_t(id)].intersect(ray))
+                    brute = true;
+            CAPTURE(seed, list, r, ray);
+            const int hit = octree.any_hit_polygon(ray, filter);
+            CHECK((hit >= 0) == brute);
+            if (hit >= 0) CHECK(std::binary_search(only.begin(), only.end(), hit));
+            n_hits_listed += brute;
+            n_hits_all += octree.any_hit(ray, RayFilter{list % 3, -1});
+        }
+    }
+    // The list matters: some rays hit only polygons that are not listed.
+    CHECK(n_hits_listed > 100);
+    CHECK(n_hits_listed < n_hits_all);
+}
+
+TEST_CASE("shadow: segment_misses_boxes never misses a box the segment enters",
+          "[shadow][occlusion]") {
+    // Random boxes and segments: a segment that has a point (of 200 along it) inside a box never
+    // misses; one that misses every box has no point inside any. Segments along a box's face
+    // and through its corner meet it; one just beside it misses.
+    const unsigned seed = 44;
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> u(0, 1);
+    long n_meet = 0, n_miss = 0;
+    for (int k = 0; k < 2000; ++k) {
+        std::vector<Box3> boxes;
+        for (int b = 0; b < 3; ++b) {
+            const Vec3 lo{u(rng), u(rng), u(rng)};
+            boxes.push_back(Box3{lo, lo + Vec3{0.6 * u(rng), 0.6 * u(rng), 0.6 * u(rng)}});
+        }
+        const Vec3 a{u(rng), u(rng), u(rng)}, b{u(rng), u(rng), u(rng)};
+        bool inside = false;
+        for (int i = 0; i <= 200 && !inside; ++i) {
+            const Vec3 x = a + (i / 200.0) * (b - a);
+            for (const Box3& box : boxes)
+                inside = inside || (x.x >= box.lo.x && x.x <= box.hi.x && x.y >= box.lo.y &&
+                                    x.y <= box.hi.y && x.z >= box.lo.z && x.z <= box.hi.z);
+        }
+        const bool misses = segment_misses_boxes(a, b, boxes);
+        CAPTURE(seed, k);
+        if (inside) CHECK_FALSE(misses);
+        (misses ? n_miss : n_meet) += 1;
+    }
+    CHECK(n_meet > 200);
+    CHECK(n_miss > 200);
+    const std::vector<Box3> unit{Box3{{0, 0, 0}, {1, 1, 1}}};
+    CHECK_FALSE(segment_misses_boxes({-1, 0.5, 1}, {2, 0.5, 1}, unit));  // along the top face
+    CHECK_FALSE(segment_misses_boxes({-1, -1, -1}, {0, 0, 0}, unit));    // ends at a corner
+    CHECK(segment_misses_boxes({-1, 0.5, 1.001}, {2, 0.5, 1.001}, unit));
+    CHECK(segment_misses_boxes({2, 2, 2}, {3, 3, 3}, unit));
+}
+
+TEST_CASE("shadow: a polygon lying on the receiver blocks no segment, few candidates or many",
+          "[shadow][occlusion]") {
+    // make_occlusion_context leaves out a polygon lying on a planar receiver (a rug on the
+    // floor, 1e-5 above it). The loop over few candidates never tests it; with many, the
+    // octree finds it on segments that leave the receiver under it, and segment_blocked must
+    // skip it there too (RayFilter::only_polygons): the answer is brute force over the
+    // candidates alone, on both paths.
+    const unsigned seed = 12;
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> u(0, 1);
+    for (const int n_occluders : {4, 40}) {
+        ShadowSetup setup = occluded_squares(0);
+        setup.occluders.clear();
+        setup.occluders.push_back(square_at(0.5, 0.5, 1e-5, 0.3));  // the rug
+        for (int i = 0; i < n_occluders; ++i) {
+            const Vec3 c{u(rng), u(rng), 0.2 + 0.6 * u(rng)};
+            setup.occluders.push_back(random_parallelogram(rng, c, 0.1));
+        }
+        const Pair pair(setup, 1);
+        const std::vector<int>& candidates = pair.context.candidates;
+        REQUIRE_FALSE(std::binary_search(candidates.begin(), candidates.end(), 2));  // the rug
+        CHECK((candidates.size() > 16) == (n_occluders > 16));
+        long n_blocked = 0;
+        for (int s = 0; s < 300; ++s) {
+            const Vec3 a = setup.shooter.point(u(rng), u(rng));
+            const Vec3 b = setup.receiver.point(0.3 + 0.4 * u(rng), 0.3 + 0.4 * u(rng));  // under the rug
+            const Ray ray{a, b - a, 1e-9, 1 - 1e-9};
+            bool brute = false;
+            for (int id : candidates)
+                if (pair.octree.polygons()[size_t(id)].intersect(ray)) brute = true;
+            CAPTURE(seed, n_occluders, s);
+            CHECK(segment_blocked(pair.context, a, b, nullptr) == brute);
+            n_blocked += brute;
+        }
+        CHECK(n_blocked < 300);  // the rug would block all of them
+    }
+}
+
 // ---- Curved neighbours: segments leave true surfaces, not facets -------------------------------
 
 namespace {

@@ -272,6 +272,7 @@ OcclusionContext make_occlusion_context(const Octree& octree, const Surface& sho
 
 void group_surface_boxes(OcclusionContext& context) {
     context.surface_boxes.clear();
+    context.surface_box_counts.clear();
     std::vector<int> surfaces;  // surface of each box
     const std::vector<Polygon>& polys = context.octree->polygons();
     for (int id : context.candidates) {
@@ -280,8 +281,11 @@ void group_surface_boxes(OcclusionContext& context) {
         if (it == surfaces.end()) {
             surfaces.push_back(poly.surface());
             context.surface_boxes.push_back(poly.bounds());
+            context.surface_box_counts.push_back(1);
         } else {
-            context.surface_boxes[size_t(it - surfaces.begin())].extend(poly.bounds());
+            const size_t k = size_t(it - surfaces.begin());
+            context.surface_boxes[k].extend(poly.bounds());
+            ++context.surface_box_counts[k];
         }
     }
 }
@@ -302,6 +306,35 @@ bool blocked_by_recent(RecentBlockers* recent, const std::vector<Polygon>& polys
 
 }  // namespace
 
+bool segment_misses_boxes(Vec3 a, Vec3 b, const std::vector<Box3>& boxes) {
+    const double origin[3] = {a.x, a.y, a.z}, dir[3] = {b.x - a.x, b.y - a.y, b.z - a.z};
+    double inverse[3];
+    for (int k = 0; k < 3; ++k) inverse[k] = dir[k] != 0 ? 1 / dir[k] : 0;
+    for (const Box3& box : boxes) {
+        const double lo[3] = {box.lo.x, box.lo.y, box.lo.z}, hi[3] = {box.hi.x, box.hi.y, box.hi.z};
+        double size = 0;
+        for (int k = 0; k < 3; ++k)
+            size = std::max({size, std::fabs(lo[k]), std::fabs(hi[k]), hi[k] - lo[k]});
+        const double grow = 1e-9 * size;
+        double t0 = 0, t1 = 1;
+        bool meets = true;
+        for (int k = 0; k < 3 && meets; ++k) {
+            const double l = lo[k] - grow, h = hi[k] + grow;
+            if (dir[k] == 0) {
+                meets = origin[k] >= l && origin[k] <= h;
+                continue;
+            }
+            double u = (l - origin[k]) * inverse[k], v = (h - origin[k]) * inverse[k];
+            if (u > v) std::swap(u, v);
+            t0 = std::max(t0, u);
+            t1 = std::min(t1, v);
+            meets = t0 <= t1;
+        }
+        if (meets) return false;
+    }
+    return true;
+}
+
 bool segment_blocked(const OcclusionContext& context, Vec3 a, Vec3 b, long* n_rays,
                      RecentBlockers* recent) {
     if (context.candidates.empty()) return false;
@@ -314,6 +347,11 @@ bool segment_blocked(const OcclusionContext& context, Vec3 a, Vec3 b, long* n_ra
     // Polygons that blocked this point's rays before were found under the same rules (the
     // octree's test is Polygon::intersect_segment's on a packed copy): a hit among them is one.
     if (blocked_by_recent(recent, polys, ray)) return true;
+    // DESIGN: a segment that misses the box of every occluding surface is clear without the
+    // octree's walk (the room's paper shadows: 12.0 M of the 13.5 M segments the octree found
+    // clear missed them all).
+    if (!context.surface_boxes.empty() && segment_misses_boxes(a, b, context.surface_boxes))
+        return false;
     int blocker = -1;
     if (context.candidates.size() <= 16) {
         for (int id : context.candidates)
@@ -322,8 +360,11 @@ bool segment_blocked(const OcclusionContext& context, Vec3 a, Vec3 b, long* n_ra
                 break;
             }
     } else {
-        blocker = context.octree->any_hit_polygon(
-            ray, RayFilter{context.shooter_surface, context.receiver_surface, true});
+        // DESIGN: only the candidates block, as in the loop above and in the lists of
+        // occluders_toward (a polygon lying on the receiver is none: make_occlusion_context).
+        RayFilter filter{context.shooter_surface, context.receiver_surface, true};
+        filter.only_polygons = &context.candidates;
+        blocker = context.octree->any_hit_polygon(ray, filter);
     }
     if (blocker >= 0 && recent) recent->note(blocker);
     return blocker >= 0;

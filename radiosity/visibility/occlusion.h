@@ -26,6 +26,7 @@ struct OcclusionContext {
     /// The candidates' bounds, one box per surface they belong to (a shaft that misses every
     /// box is clear: shaft_clear in compute_fraction).
     std::vector<Box3> surface_boxes;
+    std::vector<int> surface_box_counts;  // how many candidates each of those boxes holds
     std::uint64_t seed = 0;  // of every ray of the transfer: the pair and the shot number
     /// The scene's convex solids (convex_solids.h; null: the candidates are loose polygons).
     /// With them the candidates are split (attach_solids) into whole solids, solid_ids
@@ -46,8 +47,12 @@ std::vector<Vec3> hull_points(const Surface& surface);
 OcclusionContext pair_context(const Octree& octree, int shooter_surface, int receiver_surface,
                               std::uint64_t shot);
 
-/// Fills context.surface_boxes from its candidates.
+/// Fills context.surface_boxes (and surface_box_counts) from its candidates.
 void group_surface_boxes(OcclusionContext& context);
+
+/// Whether the segment a -> b misses every box (each grown by 1e-9 of its coordinates' size,
+/// more than a polygon's hits reach beyond its vertices' box): then it meets no polygon inside.
+bool segment_misses_boxes(Vec3 a, Vec3 b, const std::vector<Box3>& boxes);
 
 /// The occluders between two surfaces, found with the octree (nodes and polygons outside the
 /// convex hull of both surfaces' hull_points are skipped). `shot` enters the seed.
@@ -79,8 +84,8 @@ struct RecentBlockers {
 };
 
 /// True when an occluder of the context blocks the open segment a -> b (any-hit: a loop over
-/// the candidates when they are few, else the octree with the pair's own surfaces skipped; the
-/// answer is the same). Counts the ray in *n_rays. With `recent`, its polygons are tested first
+/// the candidates when they are few, else their boxes and the octree, counting the candidates
+/// only; the answer is the same). Counts the ray in *n_rays. With `recent`, its polygons are tested first
 /// and the blocker found is noted there.
 bool segment_blocked(const OcclusionContext& context, Vec3 a, Vec3 b, long* n_rays,
                      RecentBlockers* recent = nullptr);
