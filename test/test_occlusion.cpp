@@ -353,6 +353,12 @@ TEST_CASE("shadow: segment_misses_boxes never misses a box the segment enters",
     CHECK_FALSE(segment_misses_boxes({-1, -1, -1}, {0, 0, 0}, unit));    // ends at a corner
     CHECK(segment_misses_boxes({-1, 0.5, 1.001}, {2, 0.5, 1.001}, unit));
     CHECK(segment_misses_boxes({2, 2, 2}, {3, 3, 3}, unit));
+    // Grown for segments: a polygon's hit within its edge slack (1e-10 of its diameter) beyond
+    // its box lies inside the grown box; a segment 1e-8 away still misses it.
+    const std::vector<Box3> grown{grown_for_segments(unit[0])};
+    CHECK(segment_misses_boxes({-1, 0.5, 1 + 1e-10}, {2, 0.5, 1 + 1e-10}, unit));
+    CHECK_FALSE(segment_misses_boxes({-1, 0.5, 1 + 1e-10}, {2, 0.5, 1 + 1e-10}, grown));
+    CHECK(segment_misses_boxes({-1, 0.5, 1 + 1e-8}, {2, 0.5, 1 + 1e-8}, grown));
 }
 
 TEST_CASE("shadow: a polygon lying on the receiver blocks no segment, few candidates or many",

@@ -204,11 +204,13 @@ Rgb compute_fraction(const ReceiverState& state, IncrementSampler& sampler, Vec2
     }
     // A segment from p to the shooter, tested against toward when it lists every occluder,
     // else against the boxes met and then the octree.
+    std::vector<Box3> grown_boxes;  // near_boxes grown_for_segments
+    for (const Box3& box : near_boxes) grown_boxes.push_back(grown_for_segments(box));
     auto blocked = [&](Vec3 x, RecentBlockers* recent) {
         if (listed)
             return segment_blocked(ctx, toward, p.position, x, n_rays, max_listed_occluders,
                                    recent);
-        if (plane && segment_misses_boxes(p.position, x, near_boxes)) {
+        if (plane && segment_misses_boxes(p.position, x, grown_boxes)) {
             if (n_rays) ++*n_rays;
             return false;
         }

@@ -24,7 +24,8 @@ struct OcclusionContext {
     int receiver_surface = -1;
     std::vector<int> candidates;  // polygon indices, increasing
     /// The candidates' bounds, one box per surface they belong to (a shaft that misses every
-    /// box is clear: shaft_clear in compute_fraction).
+    /// box is clear, and so is a segment that misses them grown: compute_fraction,
+    /// segment_blocked).
     std::vector<Box3> surface_boxes;
     std::vector<int> surface_box_counts;  // how many candidates each of those boxes holds
     std::uint64_t seed = 0;  // of every ray of the transfer: the pair and the shot number
@@ -50,8 +51,11 @@ OcclusionContext pair_context(const Octree& octree, int shooter_surface, int rec
 /// Fills context.surface_boxes (and surface_box_counts) from its candidates.
 void group_surface_boxes(OcclusionContext& context);
 
-/// Whether the segment a -> b misses every box (each grown by 1e-9 of its coordinates' size,
-/// more than a polygon's hits reach beyond its vertices' box): then it meets no polygon inside.
+/// A box of polygons grown by 1e-9 of its coordinates' magnitude and size: more than a
+/// polygon's hits reach beyond its vertices' box (its edge slack, 1e-10 of its diameter).
+Box3 grown_for_segments(const Box3& box);
+/// Whether the segment a -> b misses every (closed) box. With the grown_for_segments boxes of
+/// some polygons, a segment that misses them all meets none of those polygons.
 bool segment_misses_boxes(Vec3 a, Vec3 b, const std::vector<Box3>& boxes);
 
 /// The occluders between two surfaces, found with the octree (nodes and polygons outside the
