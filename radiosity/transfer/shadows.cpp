@@ -100,6 +100,10 @@ PatchRays patch_rays(const std::vector<AcceptedCell<Rgb>>& partition, int rays_p
 /// the walk for the point's own occluders (see there).
 constexpr int walk_candidates = 4 * static_cast<int>(max_listed_occluders);
 
+/// A point's pyramid that meets more boxes of occluding surfaces than this tests its segments
+/// without them (each would cost more than the octree it saves): compute_fraction.
+constexpr size_t max_near_boxes = 16;
+
 /// The shaft from p to a planar patch with corners q[0..3] (in order around it): the convex hull
 /// of p and the patch, which holds every segment from p to the patch, as the four planes through
 /// p and an edge and the patch's own plane (nothing beyond the shooter blocks). DESIGN: a box
@@ -174,6 +178,7 @@ Rgb compute_fraction(const ReceiverState& state, IncrementSampler& sampler, Vec2
     // (what the rays would give, to the bit) and without the partition's kernel evaluations.
     std::vector<int> toward;
     std::vector<Box3> near_boxes;  // the pair's surface boxes that meet p's pyramid
+    bool many_boxes = false;       // more than max_near_boxes of them (the list stops there)
     bool listed = false;           // toward lists every occluder that meets the pyramid
     const ShooterPlane* plane = integrator.shooter_plane();
     if (plane) {
@@ -183,8 +188,9 @@ Rgb compute_fraction(const ReceiverState& state, IncrementSampler& sampler, Vec2
                                  shooter.point(0, 1)};
         const Shaft pyramid(p.position, corners);
         int near_count = 0;  // candidates in the boxes met
-        for (size_t k = 0; k < ctx.surface_boxes.size(); ++k)
+        for (size_t k = 0; k < ctx.surface_boxes.size() && !many_boxes; ++k)
             if (pyramid.meets(ctx.surface_boxes[k])) {
+                many_boxes = near_boxes.size() == max_near_boxes;
                 near_boxes.push_back(ctx.surface_boxes[k]);
                 near_count += k < ctx.surface_box_counts.size() ? ctx.surface_box_counts[k]
                                                                 : walk_candidates + 1;
@@ -192,12 +198,15 @@ Rgb compute_fraction(const ReceiverState& state, IncrementSampler& sampler, Vec2
         if (near_boxes.empty()) return {1, 1, 1};
         // DESIGN: the octree's walk for the occluders that meet the pyramid (occluders_toward)
         // stops beyond max_listed_occluders; then the rays go through the octree, so the list
-        // need not be complete. When the boxes met hold more than walk_candidates (4 x
-        // max_listed_occluders) candidates the walk stops at the first occluder, only to tell
-        // a clear point (fraction 1 without a ray) from the others: in the room 80 % of the
-        // full walks overflowed, 13 % of its CPU. The rays' answers do not depend on the path
-        // (only candidates block on either: segment_blocked).
-        const bool walk = near_count <= walk_candidates;
+        // need not be complete. When the boxes met (at most max_near_boxes of them) hold more
+        // than walk_candidates (4 x max_listed_occluders) candidates the walk stops at the
+        // first occluder, only to tell a clear point (fraction 1 without a ray) from the
+        // others: in the room (a few surfaces of hundreds of facets) 80 % of the full walks
+        // overflowed, 13 % of its CPU. Many boxes of few polygons each (the classroom's chairs)
+        // keep the full walk, whose short lists pay there (its 3 shots on one thread: 37.0 s
+        // with it, 59.8 s without). The rays' answers do not depend on the path (only
+        // candidates block on either: segment_blocked).
+        const bool walk = many_boxes || near_count <= walk_candidates;
         toward = occluders_toward(ctx, *plane, p.position, walk ? max_listed_occluders : 0);
         if (toward.empty()) return {1, 1, 1};
         listed = walk && toward.size() <= max_listed_occluders;
@@ -205,12 +214,13 @@ Rgb compute_fraction(const ReceiverState& state, IncrementSampler& sampler, Vec2
     // A segment from p to the shooter, tested against toward when it lists every occluder,
     // else against the boxes met and then the octree.
     std::vector<Box3> grown_boxes;  // near_boxes grown_for_segments
-    for (const Box3& box : near_boxes) grown_boxes.push_back(grown_for_segments(box));
+    if (!many_boxes)
+        for (const Box3& box : near_boxes) grown_boxes.push_back(grown_for_segments(box));
     auto blocked = [&](Vec3 x, RecentBlockers* recent) {
         if (listed)
             return segment_blocked(ctx, toward, p.position, x, n_rays, max_listed_occluders,
                                    recent);
-        if (plane && segment_misses_boxes(p.position, x, grown_boxes)) {
+        if (plane && !many_boxes && segment_misses_boxes(p.position, x, grown_boxes)) {
             if (n_rays) ++*n_rays;
             return false;
         }
@@ -235,7 +245,7 @@ Rgb compute_fraction(const ReceiverState& state, IncrementSampler& sampler, Vec2
         if (listed) {
             for (int id : toward) boxes.push_back(ctx.octree->polygons()[size_t(id)].bounds());
         } else {
-            boxes = near_boxes;
+            boxes = many_boxes ? ctx.surface_boxes : near_boxes;
         }
     }
     RecentBlockers recent;  // the point's last blockers, tested first (same answers)

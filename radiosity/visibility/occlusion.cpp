@@ -338,6 +338,9 @@ bool segment_misses_boxes(Vec3 a, Vec3 b, const std::vector<Box3>& boxes) {
     return true;
 }
 
+/// At most this many boxes of occluding surfaces are tested before a segment goes to the octree.
+constexpr size_t max_box_tests = 16;
+
 bool segment_blocked(const OcclusionContext& context, Vec3 a, Vec3 b, long* n_rays,
                      RecentBlockers* recent) {
     if (context.candidates.empty()) return false;
@@ -352,8 +355,9 @@ bool segment_blocked(const OcclusionContext& context, Vec3 a, Vec3 b, long* n_ra
     if (blocked_by_recent(recent, polys, ray)) return true;
     // DESIGN: a segment that misses the box of every occluding surface is clear without the
     // octree's walk (the room's paper shadows: 12.0 M of the 13.5 M segments the octree found
-    // clear missed them all).
-    if (!context.surface_boxes.empty()) {
+    // clear missed them all). Only for pairs with few such surfaces (max_box_tests): the
+    // classroom's pairs have thousands.
+    if (!context.surface_boxes.empty() && context.surface_boxes.size() <= max_box_tests) {
         std::vector<Box3> grown;
         grown.reserve(context.surface_boxes.size());
         for (const Box3& box : context.surface_boxes) grown.push_back(grown_for_segments(box));
