@@ -702,9 +702,19 @@ void ProgressiveSolver::superpose(const std::vector<int>& receivers, std::vector
     shot_power_[h] += shot_power;
     std::vector<SplineField> unshot_increments(n_rec);  // dB_i of the irradiance receivers
     const Rgb shooter_bound = coefficient_bound(shooter.unshot);  // >= max B_h
-    for (int k = 0; k < n_rec; ++k) {
+    // What each receiver adds to the shot's sums, added in the receivers' order afterwards.
+    struct Part {
+        double limited = 0;
+        Rgb reflected, arrived;
+    };
+    std::vector<Part> parts(n_rec);
+    // DESIGN: each receiver's part (limiter, reflected field, powers, its fields and split
+    // cells) side by side: each touches its own surface only (the receivers are distinct). In
+    // the room it ran on one thread between the shots' parallel transfers, 4.7 % of its CPU.
+    parallel_for(n_rec, [&](int k) {
         const int i = receivers[k];
         Received& r = results[k];
+        Part& part = parts[k];
         const bool irradiance = solution_.quantity[i] == FieldQuantity::irradiance;
         const Rgb rho_max = scene_.material_of(i).reflectance.maximum();
         if (options_.limiter) {
@@ -713,7 +723,7 @@ void ProgressiveSolver::superpose(const std::vector<int>& receivers, std::vector
                 options_.tolerance * radiosity_scale_ / (irradiance ? max_abs(rho_max) : 1.0);
             limit_increment(r.field, irradiance ? shooter_bound : rho_max * shooter_bound, slack);
             const Rgb change = power(i, r.field) - before;
-            shot.limited += channel_sum(
+            part.limited = channel_sum(
                 irradiance ? scene_.material_of(i).reflectance.mean() * change : change);
         }
         if (irradiance) {
@@ -723,30 +733,37 @@ void ProgressiveSolver::superpose(const std::vector<int>& receivers, std::vector
                                 options_.tolerance * radiosity_scale_);
         }
         const SplineField& dB = irradiance ? unshot_increments[k] : r.field;
-        const Rgb reflected = power(i, dB);
-        shot.reflected += channel_sum(reflected);
+        part.reflected = power(i, dB);
+        if (irradiance) part.arrived = power(i, r.field);
+        solution_.radiosity[i].add(r.field);
+        solution_.unshot[i].add(dB);
+        std::vector<std::uint64_t>& cells = split_cells_[i];
+        cells.insert(cells.end(), r.splits.begin(), r.splits.end());
+        std::sort(cells.begin(), cells.end());
+        cells.erase(std::unique(cells.begin(), cells.end()), cells.end());
+    });
+    for (int k = 0; k < n_rec; ++k) {
+        const int i = receivers[k];
+        const Received& r = results[k];
+        const Part& part = parts[k];
+        const bool irradiance = solution_.quantity[i] == FieldQuantity::irradiance;
+        shot.limited += part.limited;
+        shot.reflected += channel_sum(part.reflected);
         // Incident power: int dH A for an irradiance receiver, else what was reflected over the
         // reflectance (its mean for a texture stored as B).
         const Rgb rv = scene_.material_of(i).reflectance.mean();
-        const Rgb arrived = irradiance ? power(i, r.field) : Rgb{};
         for (int c = 0; c < 3; ++c)
             if (rv[c] > 0) {
-                const double incident = irradiance ? arrived[c] : reflected[c] / rv[c];
+                const double incident = irradiance ? part.arrived[c] : part.reflected[c] / rv[c];
                 shot.incident += incident;
                 row[i][c] += incident;
             }
-        solution_.radiosity[i].add(r.field);
-        solution_.unshot[i].add(dB);
         shot.kernel_evals += r.stats.n_kernel_evals;
         shot.analytic_evals += r.stats.n_analytic_evals;
         shot.rays += r.stats.n_rays;
         shot.paper_transfers += r.paper ? 1 : 0;
         shot.weak_transfers += r.stats.weak ? 1 : 0;
         shot.finest_level = std::max(shot.finest_level, r.field.level());
-        std::vector<std::uint64_t>& cells = split_cells_[i];
-        cells.insert(cells.end(), r.splits.begin(), r.splits.end());
-        std::sort(cells.begin(), cells.end());
-        cells.erase(std::unique(cells.begin(), cells.end()), cells.end());
     }
     const Surface& shooter_surface = scene_.surfaces[h].surface;
     if (!(options_.self_transfer && shooter_surface.is_concave() &&
