@@ -309,14 +309,16 @@ TEST_CASE("shadow: after shadow subdivision no leaf is more than twice its twelv
 
 TEST_CASE(
     "shadow: splits follow power: a leaf splits only while its area times the largest "
-    "sample reaches the tolerance times split_area",
+    "sample times its fractions' difference reaches the tolerance times split_area",
     "[shadow][shadows]") {
     // worth_splitting (shadows.cpp): with ShadowOptions::split_area set so that the bound falls
-    // between the leaves of level L and L + 1, shadow subdivision stops at level L + 1 (leaves
-    // of level L still split) where without it the same transfer reaches the shadow depth; the
-    // fractions it computes are fewer. The samples come before stage 7, so max_sample is the same
-    // in every run.
-    const ShadowSetup setup = occluded_squares(0);
+    // between the leaves of level L with fractions differing by at least 1/2 and those of level
+    // L + 1 (whose differences are at most 1), shadow subdivision stops at level L + 1 (leaves of
+    // level L across the shadow's edge still split) where without it the same transfer reaches
+    // the shadow depth; the fractions it computes are fewer. The occluder is close to the
+    // receiver, so that its shadow's edge is sharp: fractions of 0 and 1 side by side at every
+    // level. The samples come before stage 7, so max_sample is the same in every run.
+    const ShadowSetup setup = squares_with({square_at(0.5, 0.5, 0.05, 0.2)});
     const Pair pair(setup);
     ReceiverOptions options = small_options(ShadowMethod::Fractions);
     options.shadows.max_depth = 5;
@@ -337,12 +339,27 @@ TEST_CASE(
     for (int L : {2, 3}) {
         CAPTURE(L);
         ReceiverOptions limited = options;
-        limited.shadows.split_area =
-            area * std::pow(0.25, L) * S / options.absolute_tolerance * (1 - 1e-9);
+        limited.shadows.split_area = area * std::pow(0.25, L) * S / options.absolute_tolerance * 0.5;
         const Run run = run_transfer(setup, limited, &pair.context);
         CHECK(finest(run) == L + 1);
         CHECK(run.state.stats.n_fractions < full.state.stats.n_fractions);
         CHECK(run.state.stats.n_shadow_splits < full.state.stats.n_shadow_splits);
+    }
+    // A soft penumbra (the occluder half way up): neighbouring fractions never differ by 1, so
+    // with the bound at exactly a level-L leaf's area times S no leaf of level L splits (without
+    // the difference in the bound they did, down to level L + 1).
+    const ShadowSetup soft = occluded_squares(0);
+    const Pair soft_pair(soft);
+    const Run soft_probe = run_transfer(soft, options, &soft_pair.context);
+    const double S_soft = soft_probe.state.max_sample;
+    REQUIRE(finest(soft_probe) == options.shadows.max_depth);
+    for (int L : {2, 3}) {
+        CAPTURE(L);
+        ReceiverOptions limited = options;
+        limited.shadows.split_area =
+            area * std::pow(0.25, L) * S_soft / options.absolute_tolerance * (1 - 1e-9);
+        const Run run = run_transfer(soft, limited, &soft_pair.context);
+        CHECK(finest(run) <= L);
     }
 }
 
