@@ -30,6 +30,25 @@ using namespace mbr::test;
 
 // ---- The occluders of a pair and the octree queries under them ---------------------------------
 
+namespace {
+
+/// n random polygons in [0, 4]^3 (parallelograms and triangles in turn), each of a random
+/// surface 0..5.
+std::vector<Polygon> random_polygons(std::mt19937& rng, int n) {
+    std::uniform_real_distribution<double> u(0, 4);
+    std::uniform_int_distribution<int> surface(0, 5);
+    std::vector<Polygon> polygons;
+    for (int i = 0; i < n; ++i) {
+        const Vec3 c{u(rng), u(rng), u(rng)};
+        const int s = surface(rng);
+        polygons.push_back(make_polygon(
+            i % 2 ? random_parallelogram(rng, c, 0.6) : random_triangle(rng, c, 0.8), s));
+    }
+    return polygons;
+}
+
+}  // namespace
+
 TEST_CASE("shadow: any_hit with a RayFilter equals brute force over the unfiltered polygons",
           "[shadow][occlusion]") {
     // Random polygons of six surfaces, random rays with random [t_min, t_max]; for each filter the
@@ -39,14 +58,7 @@ TEST_CASE("shadow: any_hit with a RayFilter equals brute force over the unfilter
     const unsigned seed = 909;
     std::mt19937 rng(seed);
     std::uniform_real_distribution<double> u(0, 4);
-    std::uniform_int_distribution<int> surface(0, 5);
-    std::vector<Polygon> scene;
-    for (int i = 0; i < 400; ++i) {
-        const Vec3 c{u(rng), u(rng), u(rng)};
-        const int s = surface(rng);
-        scene.push_back(make_polygon(
-            i % 2 ? random_parallelogram(rng, c, 0.6) : random_triangle(rng, c, 0.8), s));
-    }
+    const std::vector<Polygon> scene = random_polygons(rng, 400);
     const Octree octree(scene, OctreeOptions{8, 4});
     const RayFilter filters[] = {RayFilter{}, RayFilter{0, -1}, RayFilter{-1, 3}, RayFilter{2, 4},
                                  RayFilter{5, 5}};
@@ -283,13 +295,7 @@ TEST_CASE("shadow: any_hit with only_polygons counts the listed polygons alone",
     const unsigned seed = 1707;
     std::mt19937 rng(seed);
     std::uniform_real_distribution<double> u(0, 4);
-    std::uniform_int_distribution<int> surface(0, 5);
-    std::vector<Polygon> scene;
-    for (int i = 0; i < 300; ++i) {
-        const Vec3 c{u(rng), u(rng), u(rng)};
-        scene.push_back(make_polygon(
-            i % 2 ? random_parallelogram(rng, c, 0.6) : random_triangle(rng, c, 0.8), surface(rng)));
-    }
+    const std::vector<Polygon> scene = random_polygons(rng, 300);
     const Octree octree(scene, OctreeOptions{8, 4});
     long n_hits_all = 0, n_hits_listed = 0;
     for (int list = 0; list < 5; ++list) {
