@@ -54,9 +54,13 @@ void group_surface_boxes(OcclusionContext& context);
 /// A box of polygons grown by 1e-9 of its coordinates' magnitude and size: more than a
 /// polygon's hits reach beyond its vertices' box (its edge slack, 1e-10 of its diameter).
 Box3 grown_for_segments(const Box3& box);
-/// Whether the segment a -> b misses every (closed) box. With the grown_for_segments boxes of
-/// some polygons, a segment that misses them all meets none of those polygons.
-bool segment_misses_boxes(Vec3 a, Vec3 b, const std::vector<Box3>& boxes);
+/// Whether the segment a -> b misses every (closed) box of boxes[0..n). With the
+/// grown_for_segments boxes of some polygons, a segment that misses them all meets none of
+/// those polygons.
+bool segment_misses_boxes(Vec3 a, Vec3 b, const Box3* boxes, size_t n);
+inline bool segment_misses_boxes(Vec3 a, Vec3 b, const std::vector<Box3>& boxes) {
+    return segment_misses_boxes(a, b, boxes.data(), boxes.size());
+}
 
 /// The occluders between two surfaces, found with the octree (nodes and polygons outside the
 /// convex hull of both surfaces' hull_points are skipped). `shot` enters the seed.
@@ -89,8 +93,8 @@ struct RecentBlockers {
 
 /// True when an occluder of the context blocks the open segment a -> b (any-hit: a loop over
 /// the candidates when they are few, else their boxes and the octree, counting the candidates
-/// only; the answer is the same). Counts the ray in *n_rays. With `recent`, its polygons are tested first
-/// and the blocker found is noted there.
+/// only; the answer is the same). Counts the ray in *n_rays. With `recent`, its polygons are
+/// tested first and the blocker found is noted there.
 bool segment_blocked(const OcclusionContext& context, Vec3 a, Vec3 b, long* n_rays,
                      RecentBlockers* recent = nullptr);
 /// The same against a subset of the candidates known to hold every polygon that can meet the
