@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <optional>
 
 #include "math/check.h"
 
@@ -440,6 +441,19 @@ void IncrementIntegrator::collect_shaft_occluders(const SurfacePoint& p, const Q
         const double s = axis_2 > 0 ? std::clamp(dot(m - p.position, axis) / axis_2, 0.0, 1.0) : 0;
         return length(m - (p.position + s * axis)) > r_nodes + rho + capsule_slack;
     };
+    // DESIGN: on a planar shooter the nodes lie in the cell's quadrilateral, so every segment
+    // lies in the pyramid from p to it (Shaft); a polygon with every vertex outside one of its
+    // planes meets none of them. Counted on corridor.mgf's first 10 shots (7.5 M cells): the
+    // box and capsule tests kept 103 of the 223 occluders of a cell on average, each tested by
+    // every node's ray.
+    std::optional<Shaft> pyramid;
+    if (planar_) {
+        const Vec3 corners[4] = {shooter_.surface->point(r.x0, r.y0),
+                                 shooter_.surface->point(r.x1, r.y0),
+                                 shooter_.surface->point(r.x1, r.y1),
+                                 shooter_.surface->point(r.x0, r.y1)};
+        pyramid.emplace(p.position, corners);
+    }
     const std::vector<Polygon>& polys = occlusion_->octree->polygons();
     const std::vector<int>& list = view_.use_rays ? view_.occluders : occlusion_->candidates;
     local_.clear();
@@ -447,6 +461,7 @@ void IncrementIntegrator::collect_shaft_occluders(const SurfacePoint& p, const Q
         const Polygon& poly = polys[id];
         if (!overlaps(poly.bounds(), shaft)) continue;
         if (outside_capsule(poly.bounds())) continue;
+        if (pyramid && pyramid->separates(poly.vertices())) continue;
         const Plane& pl = poly.plane();
         // p and the ball of the nodes on one side of the plane: no segment crosses it (inside a
         // sphere, every facet's plane but those next to p).

@@ -104,48 +104,6 @@ constexpr int walk_candidates = 4 * static_cast<int>(max_listed_occluders);
 /// without them (each would cost more than the octree it saves): compute_fraction.
 constexpr size_t max_near_boxes = 16;
 
-/// The shaft from p to a planar patch with corners q[0..3] (in order around it): the convex hull
-/// of p and the patch, which holds every segment from p to the patch, as the four planes through
-/// p and an edge and the patch's own plane (nothing beyond the shooter blocks). DESIGN: a box
-/// within 1e-9 of the coordinates' size of a plane counts as meeting it; a shaft too thin to
-/// orient meets every box.
-struct Shaft {
-    Vec3 normal[5];
-    double offset[5] = {0, 0, 0, 0, 0};
-    double tol = 0;
-    bool oriented = true;
-    Shaft(Vec3 p, const Vec3 (&q)[4]) {
-        const Vec3 centre = 0.25 * (q[0] + q[1] + q[2] + q[3]);
-        double scale = length(p);
-        for (const Vec3& c : q) scale = std::max(scale, length(c));
-        tol = 1e-9 * std::max(scale, 1.0);
-        for (int j = 0; j < 5; ++j) {
-            Vec3 n = j < 4 ? cross(q[j] - p, q[(j + 1) % 4] - p) : cross(q[1] - q[0], q[3] - q[0]);
-            const Vec3 inside = j < 4 ? centre : p;  // a point the half-space keeps
-            const Vec3 on = j < 4 ? p : q[0];
-            const double len = length(n);
-            if (!(len > 0)) {
-                oriented = false;
-                return;
-            }
-            n = (1 / len) * n;
-            if (dot(n, inside - on) > 0) n = -1.0 * n;  // inside: dot(n, x) <= offset
-            normal[j] = n;
-            offset[j] = dot(n, on);
-        }
-    }
-    bool meets(const Box3& box) const {
-        if (!oriented) return true;
-        for (int j = 0; j < 5; ++j) {
-            const Vec3& n = normal[j];
-            const Vec3 nearest{n.x > 0 ? box.lo.x : box.hi.x, n.y > 0 ? box.lo.y : box.hi.y,
-                               n.z > 0 ? box.lo.z : box.hi.z};
-            if (dot(n, nearest) - offset[j] > tol) return false;
-        }
-        return true;
-    }
-};
-
 /// Whether no box meets the shaft from p to a planar patch (Shaft).
 bool shaft_clear(Vec3 p, const Vec3 (&q)[4], const std::vector<Box3>& boxes) {
     const Shaft shaft(p, q);

@@ -307,6 +307,52 @@ bool blocked_by_recent(RecentBlockers* recent, const std::vector<Polygon>& polys
 
 }  // namespace
 
+Shaft::Shaft(Vec3 p, const Vec3 (&q)[4]) {
+    const Vec3 centre = 0.25 * (q[0] + q[1] + q[2] + q[3]);
+    double scale = length(p);
+    for (const Vec3& c : q) scale = std::max(scale, length(c));
+    tol = 1e-9 * std::max(scale, 1.0);
+    for (int j = 0; j < 5; ++j) {
+        Vec3 n = j < 4 ? cross(q[j] - p, q[(j + 1) % 4] - p) : cross(q[1] - q[0], q[3] - q[0]);
+        const Vec3 inside = j < 4 ? centre : p;  // a point the half-space keeps
+        const Vec3 on = j < 4 ? p : q[0];
+        const double len = length(n);
+        if (!(len > 0)) {
+            oriented = false;
+            return;
+        }
+        n = (1 / len) * n;
+        if (dot(n, inside - on) > 0) n = -1.0 * n;  // inside: dot(n, x) <= offset
+        normal[j] = n;
+        offset[j] = dot(n, on);
+    }
+}
+
+bool Shaft::meets(const Box3& box) const {
+    if (!oriented) return true;
+    for (int j = 0; j < 5; ++j) {
+        const Vec3& n = normal[j];
+        const Vec3 nearest{n.x > 0 ? box.lo.x : box.hi.x, n.y > 0 ? box.lo.y : box.hi.y,
+                           n.z > 0 ? box.lo.z : box.hi.z};
+        if (dot(n, nearest) - offset[j] > tol) return false;
+    }
+    return true;
+}
+
+bool Shaft::separates(const std::vector<Vec3>& points) const {
+    if (!oriented) return false;
+    for (int j = 0; j < 5; ++j) {
+        bool all_outside = true;
+        for (const Vec3& x : points)
+            if (!(dot(normal[j], x) - offset[j] > tol)) {
+                all_outside = false;
+                break;
+            }
+        if (all_outside) return true;
+    }
+    return false;
+}
+
 Box3 grown_for_segments(const Box3& box) {
     double size = length(box.extent());
     for (const Vec3& c : {box.lo, box.hi})

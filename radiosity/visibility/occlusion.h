@@ -62,6 +62,24 @@ inline bool segment_misses_boxes(Vec3 a, Vec3 b, const std::vector<Box3>& boxes)
     return segment_misses_boxes(a, b, boxes.data(), boxes.size());
 }
 
+/// The shaft from p to a planar patch with corners q[0..3] (in order around it): the convex hull
+/// of p and the patch, which holds every segment from p to the patch, as the four planes through
+/// p and an edge and the patch's own plane (nothing beyond the shooter blocks). DESIGN: a box or
+/// a polygon within 1e-9 of the coordinates' size of a plane counts as meeting it (more than a
+/// polygon's edge slack); a shaft too thin to orient meets everything.
+struct Shaft {
+    Vec3 normal[5];
+    double offset[5] = {0, 0, 0, 0, 0};
+    double tol = 0;
+    bool oriented = true;
+    Shaft(Vec3 p, const Vec3 (&q)[4]);
+    /// Whether the box may meet the shaft (no plane has it wholly outside).
+    bool meets(const Box3& box) const;
+    /// Whether every one of the points lies outside one plane of the shaft: a polygon with these
+    /// vertices meets no segment from p to the patch.
+    bool separates(const std::vector<Vec3>& points) const;
+};
+
 /// The occluders between two surfaces, found with the octree (nodes and polygons outside the
 /// convex hull of both surfaces' hull_points are skipped). `shot` enters the seed.
 OcclusionContext make_occlusion_context(const Octree& octree, const Surface& shooter,
