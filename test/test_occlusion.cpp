@@ -367,6 +367,51 @@ TEST_CASE("shadow: segment_misses_boxes never misses a box the segment enters",
     CHECK(segment_misses_boxes({-1, 0.5, 1 + 1e-8}, {2, 0.5, 1 + 1e-8}, grown));
 }
 
+TEST_CASE("shadow: a shaft separates only polygons that no segment to its patch meets",
+          "[shadow][occlusion]") {
+    // Shaft (occlusion.h): the pyramid from p to a planar quadrilateral patch. A polygon it
+    // separates (every vertex outside one plane) must meet none of the segments from p to the
+    // patch: checked on 64 segments to random points of the patch (bilinear, so inside it) for
+    // random triangles and parallelograms around the shaft; separated polygons also have boxes
+    // the shaft may or may not meet, but a polygon a segment hits is never separated and its
+    // box always meets the shaft.
+    const unsigned seed = 31;
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> u(0, 1);
+    long n_separated = 0, n_hit = 0;
+    for (int trial = 0; trial < 300; ++trial) {
+        const Vec3 p{u(rng), u(rng), 0};
+        const Vec3 q[4] = {{0.2 * u(rng), 0.2 * u(rng), 1},
+                           {0.8 + 0.2 * u(rng), 0.2 * u(rng), 1},
+                           {0.8 + 0.2 * u(rng), 0.8 + 0.2 * u(rng), 1},
+                           {0.2 * u(rng), 0.8 + 0.2 * u(rng), 1}};
+        const Shaft shaft(p, q);
+        for (int k = 0; k < 20; ++k) {
+            const Vec3 c{2 * u(rng) - 0.5, 2 * u(rng) - 0.5, 0.1 + 0.8 * u(rng)};
+            const Polygon poly = make_polygon(
+                k % 2 ? random_parallelogram(rng, c, 0.3) : random_triangle(rng, c, 0.4), 2);
+            bool hit = false;
+            for (int r = 0; r < 64 && !hit; ++r) {
+                const double a = u(rng), b = u(rng);
+                const Vec3 x = (1 - a) * (1 - b) * q[0] + a * (1 - b) * q[1] + a * b * q[2] +
+                               (1 - a) * b * q[3];
+                hit = bool(poly.intersect(Ray{p, x - p, 1e-9, 1 - 1e-9}));
+            }
+            const bool separated = shaft.separates(poly.vertices());
+            CAPTURE(seed, trial, k);
+            if (hit) {
+                CHECK_FALSE(separated);
+                CHECK(shaft.meets(poly.bounds()));
+            }
+            n_separated += separated;
+            n_hit += hit;
+        }
+    }
+    // Both kinds occur.
+    CHECK(n_separated > 1000);
+    CHECK(n_hit > 200);
+}
+
 TEST_CASE("shadow: a polygon lying on the receiver blocks no segment, few candidates or many",
           "[shadow][occlusion]") {
     // make_occlusion_context leaves out a polygon lying on a planar receiver (a rug on the
