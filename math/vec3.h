@@ -86,6 +86,8 @@ inline Rgb& operator*=(Rgb& a, double s) { a = s * a; return a; }
 inline bool operator==(Rgb a, Rgb b) { return a.r == b.r && a.g == b.g && a.b == b.b; }
 /// Largest absolute channel: the norm used by adaptive rules that integrate all three at once.
 inline double max_abs(Rgb a) { return std::max({std::fabs(a.r), std::fabs(a.g), std::fabs(a.b)}); }
+/// The sum of the three channels (a power or radiosity summed over colours).
+inline double channel_sum(Rgb a) { return a.r + a.g + a.b; }
 inline double max_abs(double a) { return std::fabs(a); }
 inline double luminance(Rgb a) { return 0.2126 * a.r + 0.7152 * a.g + 0.0722 * a.b; }
 inline std::ostream& operator<<(std::ostream& os, Rgb a) {

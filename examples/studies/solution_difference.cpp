@@ -41,10 +41,6 @@ const char* usage =
     "  --worst N  also list the N points that differ most (surface, u, v, B_a, B_b)\n"
     "  --csv      one CSV row\n";
 
-double channel_sum(mbr::Rgb c) {
-    return c.r + c.g + c.b;
-}
-
 int run(mbr::Args& args) {
     const int k_points = args.integer("--points", 4, 1, 10000);
     const int seed = args.integer("--seed", 1, 0, 1000000000);
@@ -75,7 +71,7 @@ int run(mbr::Args& args) {
             const double u = mbr::uniform01(key, 2 * std::uint64_t(k));
             const double v = mbr::uniform01(key, 2 * std::uint64_t(k) + 1);
             points.push_back(
-                {channel_sum(view_a.at(i, u, v)), channel_sum(view_b.at(i, u, v)), share, i, u, v});
+                {mbr::channel_sum(view_a.at(i, u, v)), mbr::channel_sum(view_b.at(i, u, v)), share, i, u, v});
         }
     }
     if (points.empty()) throw mbr::UsageError("the scene has no surface that does not emit");

@@ -29,10 +29,6 @@ double now() {
         .count();
 }
 
-double channel_sum(Rgb c) {
-    return c.r + c.g + c.b;
-}
-
 /// For each j, the sum of values[k] over k != j: the sum before j plus the sum after it, not the
 /// total minus values[j] (which a floor of 1e16 beside a 1 x 1 lamp cancels to zero: 1e16 + 1
 /// rounds to 1e16). Linear in the values.
