@@ -611,7 +611,8 @@ std::vector<ProgressiveSolver::Received> ProgressiveSolver::transfer_to(
                  [&](int k) { contexts[size_t(k)] = occlusion_of(h, receivers[k], shot_number); });
     for (int k = 0; k < n_rec; ++k) {  // keep new pairs' candidates, within the bound
         const OcclusionContext& c = contexts[size_t(k)];
-        const size_t size = c.candidates.size() + 12 * c.surface_boxes.size();  // in ints
+        const size_t size =
+            c.candidates.size() + 25 * c.surface_boxes.size();  // in ints: two boxes and a count
         if (options_.receiver.shadows.method == ShadowMethod::None ||
             candidates_.count({h, receivers[k]}) ||
             cached_candidates_ + size > max_cached_candidates)

@@ -136,6 +136,7 @@ Rgb compute_fraction(const ReceiverState& state, IncrementSampler& sampler, Vec2
     // (what the rays would give, to the bit) and without the partition's kernel evaluations.
     std::vector<int> toward;
     std::vector<Box3> near_boxes;  // the pair's surface boxes that meet p's pyramid
+    std::vector<Box3> grown_boxes;  // the same, grown_for_segments (OcclusionContext::segment_boxes)
     bool many_boxes = false;       // more than max_near_boxes of them (the list stops there)
     bool listed = false;           // toward lists every occluder that meets the pyramid
     const ShooterPlane* plane = integrator.shooter_plane();
@@ -150,8 +151,8 @@ Rgb compute_fraction(const ReceiverState& state, IncrementSampler& sampler, Vec2
             if (pyramid.meets(ctx.surface_boxes[k])) {
                 many_boxes = near_boxes.size() == max_near_boxes;
                 near_boxes.push_back(ctx.surface_boxes[k]);
-                near_count += k < ctx.surface_box_counts.size() ? ctx.surface_box_counts[k]
-                                                                : walk_candidates + 1;
+                grown_boxes.push_back(ctx.segment_boxes[k]);
+                near_count += ctx.surface_box_counts[k];
             }
         if (near_boxes.empty()) return {1, 1, 1};
         // DESIGN: the octree's walk for the occluders that meet the pyramid (occluders_toward)
@@ -171,9 +172,6 @@ Rgb compute_fraction(const ReceiverState& state, IncrementSampler& sampler, Vec2
     }
     // A segment from p to the shooter, tested against toward when it lists every occluder,
     // else against the boxes met and then the octree.
-    std::vector<Box3> grown_boxes;  // near_boxes grown_for_segments
-    if (!many_boxes)
-        for (const Box3& box : near_boxes) grown_boxes.push_back(grown_for_segments(box));
     auto blocked = [&](Vec3 x, RecentBlockers* recent) {
         if (listed)
             return segment_blocked(ctx, toward, p.position, x, n_rays, max_listed_occluders,

@@ -3,7 +3,6 @@
 #include "radiosity/visibility/occlusion.h"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <optional>
 
@@ -289,6 +288,9 @@ void group_surface_boxes(OcclusionContext& context) {
             ++context.surface_box_counts[k];
         }
     }
+    context.segment_boxes.clear();
+    for (const Box3& box : context.surface_boxes)
+        context.segment_boxes.push_back(grown_for_segments(box));
 }
 
 namespace {
@@ -361,12 +363,11 @@ Box3 grown_for_segments(const Box3& box) {
     return Box3{box.lo - grow, box.hi + grow};
 }
 
-bool segment_misses_boxes(Vec3 a, Vec3 b, const Box3* boxes, size_t n) {
+bool segment_misses_boxes(Vec3 a, Vec3 b, const std::vector<Box3>& boxes) {
     const double origin[3] = {a.x, a.y, a.z}, dir[3] = {b.x - a.x, b.y - a.y, b.z - a.z};
     double inverse[3];
     for (int k = 0; k < 3; ++k) inverse[k] = dir[k] != 0 ? 1 / dir[k] : 0;
-    for (size_t i = 0; i < n; ++i) {
-        const Box3& box = boxes[i];
+    for (const Box3& box : boxes) {
         const double lo[3] = {box.lo.x, box.lo.y, box.lo.z}, hi[3] = {box.hi.x, box.hi.y, box.hi.z};
         double t0 = 0, t1 = 1;
         bool meets = true;
@@ -405,12 +406,9 @@ bool segment_blocked(const OcclusionContext& context, Vec3 a, Vec3 b, long* n_ra
     // octree's walk (the room's paper shadows: 12.0 M of the 13.5 M segments the octree found
     // clear missed them all). Only for pairs with few such surfaces (max_box_tests): the
     // classroom's pairs have thousands.
-    if (!context.surface_boxes.empty() && context.surface_boxes.size() <= max_box_tests) {
-        std::array<Box3, max_box_tests> grown;  // on the stack: this runs once per segment
-        const size_t n = context.surface_boxes.size();
-        for (size_t i = 0; i < n; ++i) grown[i] = grown_for_segments(context.surface_boxes[i]);
-        if (segment_misses_boxes(a, b, grown.data(), n)) return false;
-    }
+    const std::vector<Box3>& boxes = context.segment_boxes;
+    if (!boxes.empty() && boxes.size() <= max_box_tests && segment_misses_boxes(a, b, boxes))
+        return false;
     int blocker = -1;
     if (context.candidates.size() <= 16) {
         for (int id : context.candidates)

@@ -28,6 +28,7 @@ struct OcclusionContext {
     /// segment_blocked).
     std::vector<Box3> surface_boxes;
     std::vector<int> surface_box_counts;  // how many candidates each of those boxes holds
+    std::vector<Box3> segment_boxes;      // each of those boxes grown_for_segments
     std::uint64_t seed = 0;  // of every ray of the transfer: the pair and the shot number
     /// The scene's convex solids (convex_solids.h; null: the candidates are loose polygons).
     /// With them the candidates are split (attach_solids) into whole solids, solid_ids
@@ -48,19 +49,15 @@ std::vector<Vec3> hull_points(const Surface& surface);
 OcclusionContext pair_context(const Octree& octree, int shooter_surface, int receiver_surface,
                               std::uint64_t shot);
 
-/// Fills context.surface_boxes (and surface_box_counts) from its candidates.
+/// Fills context.surface_boxes (with surface_box_counts and segment_boxes) from its candidates.
 void group_surface_boxes(OcclusionContext& context);
 
 /// A box of polygons grown by 1e-9 of its coordinates' magnitude and size: more than a
 /// polygon's hits reach beyond its vertices' box (its edge slack, 1e-10 of its diameter).
 Box3 grown_for_segments(const Box3& box);
-/// Whether the segment a -> b misses every (closed) box of boxes[0..n). With the
-/// grown_for_segments boxes of some polygons, a segment that misses them all meets none of
-/// those polygons.
-bool segment_misses_boxes(Vec3 a, Vec3 b, const Box3* boxes, size_t n);
-inline bool segment_misses_boxes(Vec3 a, Vec3 b, const std::vector<Box3>& boxes) {
-    return segment_misses_boxes(a, b, boxes.data(), boxes.size());
-}
+/// Whether the segment a -> b misses every (closed) box. With the grown_for_segments boxes of
+/// some polygons, a segment that misses them all meets none of those polygons.
+bool segment_misses_boxes(Vec3 a, Vec3 b, const std::vector<Box3>& boxes);
 
 /// The shaft from p to a planar patch with corners q[0..3] (in order around it): the convex hull
 /// of p and the patch, which holds every segment from p to the patch, as the four planes through
