@@ -47,6 +47,17 @@ std::vector<Polygon> random_polygons(std::mt19937& rng, int n) {
     return polygons;
 }
 
+/// n random parallelograms of the given size between the squares of occluded_squares, their
+/// centres uniform over the unit square in x and y and over [z0, z1] in height.
+void add_random_occluders(ShadowSetup& setup, std::mt19937& rng, int n, double z0, double z1,
+                          double size) {
+    std::uniform_real_distribution<double> u(0, 1);
+    for (int i = 0; i < n; ++i) {
+        const Vec3 c{u(rng), u(rng), z0 + (z1 - z0) * u(rng)};
+        setup.occluders.push_back(random_parallelogram(rng, c, size));
+    }
+}
+
 }  // namespace
 
 TEST_CASE("shadow: any_hit with a RayFilter equals brute force over the unfiltered polygons",
@@ -259,10 +270,7 @@ TEST_CASE("shadow: segment_blocked equals brute force with few and with many can
         const int n_occluders = config % 2 ? 6 : 60;
         ShadowSetup setup = occluded_squares(0);
         setup.occluders.clear();
-        for (int i = 0; i < n_occluders; ++i) {
-            const Vec3 c{u(rng), u(rng), 0.1 + 0.8 * u(rng)};
-            setup.occluders.push_back(random_parallelogram(rng, c, n_occluders > 10 ? 0.15 : 0.3));
-        }
+        add_random_occluders(setup, rng, n_occluders, 0.1, 0.9, n_occluders > 10 ? 0.15 : 0.3);
         const Pair pair(setup, config);
         const bool many = pair.context.candidates.size() > 16;
         (many ? n_many : n_few) += 1;
@@ -426,10 +434,7 @@ TEST_CASE("shadow: a polygon lying on the receiver blocks no segment, few candid
         ShadowSetup setup = occluded_squares(0);
         setup.occluders.clear();
         setup.occluders.push_back(square_at(0.5, 0.5, 1e-5, 0.3));  // the rug
-        for (int i = 0; i < n_occluders; ++i) {
-            const Vec3 c{u(rng), u(rng), 0.2 + 0.6 * u(rng)};
-            setup.occluders.push_back(random_parallelogram(rng, c, 0.1));
-        }
+        add_random_occluders(setup, rng, n_occluders, 0.2, 0.8, 0.1);
         const Pair pair(setup, 1);
         const std::vector<int>& candidates = pair.context.candidates;
         REQUIRE_FALSE(std::binary_search(candidates.begin(), candidates.end(), 2));  // the rug
