@@ -275,3 +275,66 @@ TEST_CASE("probe: results are written with the exact headers at full precision",
           "name,B_r,B_g,B_b,se_r,se_g,se_b\n"
           "a,1,2,3,0.25,0.125,0.666666667\n");
 }
+
+TEST_CASE("probe: B at a disk's centre or a sphere's pole is the mean along the collapsed edge",
+          "[probe]") {
+    // A field that changes along every parameter direction, so that its values at a centre or
+    // pole differ with the direction they are approached from.
+    const int m = 4, level = 2;
+    SplineField field(m, level);
+    for (int k = -(m - 1); k < (1 << level); ++k)
+        for (int l = -(m - 1); l < (1 << level); ++l)
+            field.set_coefficient(k, l, Rgb{1.0 + 0.3 * k + 0.7 * l, 2.0 - 0.2 * l, 0.5 + 0.1 * k});
+    const std::vector<SplineField> fields{field};
+    const RadiosityView view(fields);
+    // The mean along an edge by a plain midpoint sum, independent of the Gauss rule used.
+    auto edge_mean = [&](int axis, double at) {
+        const int n = 20000;
+        Rgb sum;
+        for (int i = 0; i < n; ++i) {
+            const double t = (i + 0.5) / n;
+            sum += axis == 0 ? view.at(0, at, t) : view.at(0, t, at);
+        }
+        return (1.0 / n) * sum;
+    };
+    struct Pole {
+        std::string name;
+        Surface surface;
+        int axis;  // the collapsed edge: u = at (axis 0) or v = at (axis 1)
+        double at;
+    };
+    const std::vector<Pole> poles{
+        {"disk centre", Surface::disk({0, 0, 1}, {0, 0, 1}, {1, 0, 0}, 0, 0.7, 0, 2 * Pi), 0, 0},
+        // v = 1 is the pole theta = 0 (an outward sphere's v runs from theta1 down to theta0).
+        {"sphere pole", Surface::sphere({0, 0, 0}, {0, 1, 0}, {1, 0, 0}, 0.7, 0, Pi, 0, 2 * Pi),
+         1, 1},
+    };
+    for (const Pole& pole : poles) {
+        CAPTURE(pole.name);
+        const Scene scene = scene_of({pole.surface});
+        const std::vector<Polygon> polygons = scene_polygons(scene, scene.settings.tessellation);
+        const Vec3 p = pole.axis == 0 ? pole.surface.point(pole.at, 0.3)
+                                      : pole.surface.point(0.3, pole.at);
+        const std::optional<SurfaceLocation> loc =
+            locate_on_surface(scene, polygons, p, probe_tolerance(scene));
+        REQUIRE(loc);
+        const Rgb mean = edge_mean(pole.axis, pole.at);
+        // The located direction is arbitrary: any (u, v) of the edge gives the same value.
+        for (double t : {0.0, 0.2, 0.55, 1.0}) {
+            SurfaceLocation at = *loc;
+            (pole.axis == 0 ? at.v : at.u) = t;
+            (pole.axis == 0 ? at.u : at.v) = pole.at;
+            const Rgb b = radiosity_at(view, scene, at);
+            CAPTURE(t, b, mean);
+            CHECK(max_abs(b - mean) < 1e-6);
+        }
+        // The field does differ along the edge, so the mean is not any one direction's value.
+        const Rgb one_way = pole.axis == 0 ? view.at(0, pole.at, 0.2) : view.at(0, 0.2, pole.at);
+        CHECK(max_abs(one_way - mean) > 0.05);
+        // Away from the pole the value is the field's own.
+        const std::optional<SurfaceLocation> off = locate_on_surface(
+            scene, polygons, pole.surface.point(0.4, 0.3), probe_tolerance(scene));
+        REQUIRE(off);
+        CHECK(max_abs(radiosity_at(view, scene, *off) - view.at(0, off->u, off->v)) == 0);
+    }
+}

@@ -594,7 +594,7 @@ int probe_command(Args& args) {
     const RadiosityView view = radiosity_view(shown, solution);  // B = E + rho H for H fields
     for (size_t i = 0; i < points.size(); ++i) {
         names.push_back(points[i].name);
-        values.push_back(view.at(at[i].surface, at[i].u, at[i].v));
+        values.push_back(radiosity_at(view, shown, at[i]));
     }
     write_radiosity_csv(std::cout, names, values);
     return 0;

@@ -223,7 +223,7 @@ int run(Args& args) {
         int n_lit = 0, n_shadow = 0;
         const RadiosityView view = radiosity_view(run.scene, solution);
         for (size_t i = 0; i < ref.size(); ++i) {
-            const Rgb B = view.at(at[i].surface, at[i].u, at[i].v);
+            const Rgb B = radiosity_at(view, run.scene, at[i]);
             const double e = luminance(B) / luminance(ref[i].B) - 1;
             r.errors.push_back(e);
             r.mean += std::fabs(e);

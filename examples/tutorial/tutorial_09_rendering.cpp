@@ -228,7 +228,7 @@ int run(Args& args) {
     const RadiosityView view = radiosity_view(scene, solution);  // B = E + rho H where it holds H
     for (size_t i = 0; i < points.size(); ++i) {
         const Reference& r = ref.at(points[i].name);
-        const Rgb B = view.at(at[i].surface, at[i].u, at[i].v);
+        const Rgb B = radiosity_at(view, scene, at[i]);
         const double e = luminance(B) / luminance(r.B) - 1;
         errors.push_back(e);
         sum += std::fabs(e);

@@ -12,6 +12,7 @@
 
 #include "math/vec3.h"
 #include "octree/polygon.h"
+#include "radiosity/geometry/radiosity_view.h"
 #include "radiosity/scene/scene.h"
 
 namespace mbr {
@@ -86,6 +87,15 @@ std::vector<SurfaceLocation> locate_probe_points(const Scene& scene,
                                                  const std::vector<Polygon>& polygons,
                                                  const std::vector<ProbePoint>& points,
                                                  const std::string& path, double tolerance);
+
+/// B at a located point, eq. (2): view.at(surface, u, v), except where the point is the image of
+/// a whole parameter edge (a disk's centre, a sphere's pole: the edge u = 0 of a disk with r0 =
+/// 0). There a field's value depends on the direction the point is approached from (on the room's
+/// stool the values at its seat's centre spread by 9 % of their mean), and the located (u, v) picks
+/// one direction arbitrarily; the mean along that edge is returned instead, the limit of B's
+/// means over small circles around the point (8-point Gauss-Legendre on each of the field's
+/// 2^level cells along the edge: exact for orders up to 16).
+Rgb radiosity_at(const RadiosityView& view, const Scene& scene, const SurfaceLocation& at);
 
 /// Writes `name,B_r,B_g,B_b` and one row per point (%.9g: doubles' values to 9 digits).
 void write_radiosity_csv(std::ostream& os, const std::vector<std::string>& names,
