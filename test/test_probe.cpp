@@ -306,15 +306,15 @@ TEST_CASE("probe: B at a disk's centre or a sphere's pole is the mean along the 
     const std::vector<Pole> poles{
         {"disk centre", Surface::disk({0, 0, 1}, {0, 0, 1}, {1, 0, 0}, 0, 0.7, 0, 2 * Pi), 0, 0},
         // v = 1 is the pole theta = 0 (an outward sphere's v runs from theta1 down to theta0).
-        {"sphere pole", Surface::sphere({0, 0, 0}, {0, 1, 0}, {1, 0, 0}, 0.7, 0, Pi, 0, 2 * Pi),
-         1, 1},
+        {"sphere pole", Surface::sphere({0, 0, 0}, {0, 1, 0}, {1, 0, 0}, 0.7, 0, Pi, 0, 2 * Pi), 1,
+         1},
     };
     for (const Pole& pole : poles) {
         CAPTURE(pole.name);
         const Scene scene = scene_of({pole.surface});
         const std::vector<Polygon> polygons = scene_polygons(scene, scene.settings.tessellation);
-        const Vec3 p = pole.axis == 0 ? pole.surface.point(pole.at, 0.3)
-                                      : pole.surface.point(0.3, pole.at);
+        const Vec3 p =
+            pole.axis == 0 ? pole.surface.point(pole.at, 0.3) : pole.surface.point(0.3, pole.at);
         const std::optional<SurfaceLocation> loc =
             locate_on_surface(scene, polygons, p, probe_tolerance(scene));
         REQUIRE(loc);
