@@ -64,8 +64,9 @@ const char* const room_surfaces[8][2] = {{"rectangle floor.a   white", "0 0 0   
 /// The mixed room's orders: the floor 3, the lamp 4, the rest 2 and 4.
 const std::vector<int> mixed_orders = {3, 3, 4, 2, 2, 4, 4, 2};
 
-/// The room with `orders` per surface (0: no `order` word) and `set order global`.
-std::string room_text(const std::vector<int>& orders, int global) {
+/// The room with `orders` per surface (0: no `order` word), `set order global` and `set
+/// tolerance tolerance`.
+std::string room_text(const std::vector<int>& orders, int global, double tolerance = 0.01) {
     std::string text =
         "material white reflectance 0.5 0.5 0.5\n"
         "material lamp  reflectance 0.5 0.5 0.5 emission 1 1 1\n";
@@ -78,7 +79,9 @@ std::string room_text(const std::vector<int>& orders, int global) {
     // figures measured below are the method's, not the tolerance's.
     text += "set order " + std::to_string(global) +
             "\n"
-            "set tolerance 0.01\n"
+            "set tolerance " +
+            std::to_string(tolerance) +
+            "\n"
             "set max_shots 60\n"
             "set convergence 1e-3\n";
     return text;
@@ -90,9 +93,9 @@ struct Solved {
 };
 
 /// The room solved with the scene's settings (each case once per run of the tests).
-const Solved& solved_room(const std::vector<int>& orders, int global) {
+const Solved& solved_room(const std::vector<int>& orders, int global, double tolerance = 0.01) {
     static std::list<std::pair<std::string, Solved>> cache;  // a list: references stay valid
-    const std::string text = room_text(orders, global);
+    const std::string text = room_text(orders, global, tolerance);
     for (const auto& [key, s] : cache)
         if (key == text) return s;
     Solved s;
@@ -285,14 +288,19 @@ TEST_CASE("mixed_order: a room of orders 2, 3 and 4 solves, each field of its su
 }
 
 TEST_CASE("mixed_order: the two order-3 floor pieces meet continuously", "[mixed_order][solver]") {
-    // Measured (the settings of room_text): across the shared edge B differs by at most 0.35 %
-    // of its largest value there in the mixed room, 0.36 % with every surface of order 3 and
-    // 0.29 % with every one of order 4; along the edge B falls to 0.80 of its largest value (the
-    // corners). The bound leaves three times that.
+    // Measured (the settings of room_text at tolerance 5e-3, shooters at level 4): across the
+    // shared edge B differs by at most 0.21 % of its largest value there in the mixed room,
+    // 0.25 % with every surface of order 3 and 0.24 % with every one of order 4; along the edge
+    // B falls to 0.80 of its largest value (the corners). The bound leaves four times that.
+    // DESIGN: tolerance 5e-3, not room_text's 1e-2: at 1e-2 a weak wall's shot into the corner
+    // where both pieces touch it is accepted with an error of the tolerance's size (the mixed
+    // room read 1.06 % with shooters at level 4 and 0.29 % at level 3; 0.14-0.35 % at 2e-2,
+    // 5e-3 and 3e-3 with either level).
+    const double tolerance = 5e-3;
     double smallest = 0;
-    const double mixed = floor_edge_gap(solved_room(mixed_orders, 4), &smallest);
-    const double uniform = floor_edge_gap(solved_room(std::vector<int>(8, 3), 4));
-    const double uniform4 = floor_edge_gap(solved_room(std::vector<int>(8, 4), 4));
+    const double mixed = floor_edge_gap(solved_room(mixed_orders, 4, tolerance), &smallest);
+    const double uniform = floor_edge_gap(solved_room(std::vector<int>(8, 3), 4, tolerance));
+    const double uniform4 = floor_edge_gap(solved_room(std::vector<int>(8, 4), 4, tolerance));
     test::report() << "floor edge gap: mixed " << 100 * mixed << " %, all order 3 " << 100 * uniform
                    << " %, all order 4 " << 100 * uniform4 << " %; smallest B on the edge "
                    << smallest << " of the largest\n";
@@ -304,7 +312,8 @@ TEST_CASE("mixed_order: the two order-3 floor pieces meet continuously", "[mixed
 TEST_CASE("mixed_order: the closed room keeps its power balance", "[mixed_order][solver]") {
     // A closed box of reflectance 0.5 whose lamp emits P = 1 (area 1, E = 1): the sum of
     // int B A over the surfaces is P / (1 - rho) = 2 (the ambient correction sends on what is
-    // unshot). Measured: mixed -0.025 %, all order 3 -0.036 %, all order 4 -0.063 %; the bound
+    // unshot). Measured (shooters at level 4): mixed -0.044 %, all order 3 -0.038 %, all order
+    // 4 -0.062 %; the bound
     // is 0.5 %, far below the power of a surface lost.
     for (const std::vector<int>& orders :
          {mixed_orders, std::vector<int>(8, 3), std::vector<int>(8, 4)}) {

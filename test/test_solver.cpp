@@ -454,7 +454,7 @@ TEST_CASE("solver: a surface solved at depth 8 shoots", "[solver][slow]") {
     // A small floor under a small light, the receivers' trees forced to depth 8 everywhere;
     // then the floor, holding a level-8 field, shoots to a panel above the light's plane (which
     // the light cannot reach, so that only the floor receives in the first shot). The floor's
-    // field is coarsened to shooter_level before it shoots (the default, 3) or shoots whole (8).
+    // field is coarsened to level 3 before it shoots (the default was 3) or shoots whole (8).
     const Scene scene = scene_from(
         "material light reflectance 0 0 0 emission 4 4 4\n"
         "material grey  reflectance 0.5 0.5 0.5\n"

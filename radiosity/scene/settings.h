@@ -76,7 +76,7 @@ struct SolverSettings {
     bool ambient_final = true;  //   and bright surfaces once more, finer (the final gather)
     bool limiter = true;        // increments and final fields clipped to their physical bounds
     bool hidden = true;         // hidden regions take their visible neighbours' values
-    int shooter_level = 3;      // a shooter's unshot field coarsened to at most this level
+    int shooter_level = 4;      // a shooter's unshot field coarsened to at most this level
     int contact_depth = 2;      // receiver cells touching a planar shooter split to at
                                 //   least this level (0: off)
     OracleSetting oracle = OracleSetting::Hybrid;

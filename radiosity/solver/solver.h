@@ -55,7 +55,7 @@ struct SolverOptions {
     bool hidden_regions = true;     // beyond the paper: samples at points that see no front
                                     //   face take the nearest visible point's value
                                     //   (radiosity/visibility/hidden_regions.h)
-    int shooter_level = 3;          // a shooter's unshot field is coarsened to at most this
+    int shooter_level = 4;          // a shooter's unshot field is coarsened to at most this
                                     //   level (the paper's "lower resolution version", section
                                     //   6); the receiver options' shooter_coarsening levels at
                                     //   least (levels 4 and 5 measured: docs/method.md)
