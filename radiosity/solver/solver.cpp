@@ -226,6 +226,14 @@ SolverOptions solver_options(const SolverSettings& s) {
     return o;
 }
 
+namespace {
+
+// Gauss-Legendre points per cell along each direction of l2_projection's rule (textures are
+// only piecewise smooth).
+constexpr int projection_points = 8;
+
+}  // namespace
+
 SplineField l2_projection_of_samples(int m, int level, int points, const Rgb* samples) {
     // L2([0,1]^2) projection onto the touching basis of the level: (G x G) c = b with
     // b_kl = int int f N_k N_l by the samples' Gauss rule and the 1D Gram matrix G, exact by
@@ -247,31 +255,46 @@ SplineField l2_projection_of_samples(int m, int level, int points, const Rgb* sa
                         G[size_t(ka) * n + kb] += w * v[a] * v[b];
                 }
         }
+    // b_kl = sum_S sum_T w_S w_T f(s_S, t_T) N_k(s_S) N_l(t_T), summed separably: first along
+    // t for every row S (T_S,l), then along s (m + m n / side products a sample instead of m^2).
+    struct Node1d {
+        int first;  // the first basis function not zero there, minus `first`
+        double w;   // the weight of the node's Gauss rule, scaled to its cell
+        double v[16];
+    };
+    std::vector<Node1d> nodes(side);
+    for (int S = 0; S < side; ++S) {
+        const double s = projection_sample_coordinate(rule_b, S, level);
+        nodes[S].first = bspline_values(m, std::ldexp(s, level), nodes[S].v) - first;
+        nodes[S].w = 0.5 * rule_b.w[S % points] / cells;
+    }
+    std::vector<std::array<double, 3>> rows(size_t(side) * n);  // rows[S * n + l][c]
+    for (int S = 0; S < side; ++S) {
+        std::array<double, 3>* row = rows.data() + size_t(S) * n;
+        for (int T = 0; T < side; ++T) {
+            const Node1d& t = nodes[T];
+            const Rgb value = samples[size_t(S) * side + T];
+            for (int b = 0; b < m; ++b) {
+                const int l = t.first + b;
+                if (l < 0 || l >= n) continue;
+                const double e = t.w * t.v[b];
+                for (int c = 0; c < 3; ++c) row[l][c] += e * value[c];
+            }
+        }
+    }
     std::array<std::vector<double>, 3> B;  // B[c][k][l]
     for (std::vector<double>& b : B) b.assign(size_t(n) * n, 0.0);
-    double vs[16], vt[16];
-    for (int ci = 0; ci < cells; ++ci)
-        for (int qa = 0; qa < rule_b.n(); ++qa) {
-            const double s = projection_sample_coordinate(rule_b, ci * points + qa, level);
-            const int fk = bspline_values(m, std::ldexp(s, level), vs);
-            for (int cj = 0; cj < cells; ++cj)
-                for (int qb = 0; qb < rule_b.n(); ++qb) {
-                    const double t = projection_sample_coordinate(rule_b, cj * points + qb, level);
-                    const int fl = bspline_values(m, std::ldexp(t, level), vt);
-                    const double w = 0.25 * rule_b.w[qa] * rule_b.w[qb] / (double(cells) * cells);
-                    const Rgb value =
-                        samples[size_t(ci * points + qa) * side + size_t(cj * points + qb)];
-                    for (int c = 0; c < 3; ++c) {
-                        const double e = w * value[c];
-                        for (int a = 0; a < m; ++a)
-                            for (int b = 0; b < m; ++b) {
-                                const int k = fk + a - first, l = fl + b - first;
-                                if (k >= 0 && k < n && l >= 0 && l < n)
-                                    B[c][size_t(k) * n + l] += e * vs[a] * vt[b];
-                            }
-                    }
-                }
+    for (int S = 0; S < side; ++S) {
+        const Node1d& s = nodes[S];
+        const std::array<double, 3>* row = rows.data() + size_t(S) * n;
+        for (int a = 0; a < m; ++a) {
+            const int k = s.first + a;
+            if (k < 0 || k >= n) continue;
+            const double e = s.w * s.v[a];
+            for (int c = 0; c < 3; ++c)
+                for (int l = 0; l < n; ++l) B[c][size_t(k) * n + l] += e * row[l][c];
         }
+    }
     SplineField field(m, level);
     for (int c = 0; c < 3; ++c) {
         // C = G^-1 B G^-1: solve column by column, then row by row.
@@ -292,8 +315,7 @@ SplineField l2_projection_of_samples(int m, int level, int points, const Rgb* sa
 }
 
 SplineField l2_projection(const std::function<Rgb(double, double)>& f, int m, int level) {
-    // f at 8 x 8 Gauss points per cell (textures are only piecewise smooth).
-    constexpr int points = 8;
+    constexpr int points = projection_points;  // f at 8 x 8 Gauss points per cell
     const int cells = 1 << level, side = cells * points;
     const GaussLegendre rule = gauss_legendre(points);
     std::vector<Rgb> samples(size_t(side) * side);
@@ -526,10 +548,22 @@ SplineField ProgressiveSolver::reflected_field(int surface, const SplineField& d
     // dB = rho dH (eq. (2)), projected at the increment's level, at most the emission's: the
     // unshot field only shoots, coarsened to shooter_level, and its power is what must be right
     // (an L2 projection keeps the integral of rho dH over a planar surface).
+    // The samples of l2_projection's rule, dH on the tensor grid (evaluate_grid: separable).
     const Texture& rho = scene_.material_of(surface).reflectance;
     const int level = std::min(dH.level(), SolverOptions::emission_level);
-    return l2_projection([&](double s, double t) { return rho.value(s, t) * dH.evaluate(s, t); },
-                         order_[surface], level);
+    const int side = (1 << level) * projection_points;
+    const GaussLegendre rule = gauss_legendre(projection_points);
+    std::vector<double> at(side);
+    for (int i = 0; i < side; ++i) at[i] = projection_sample_coordinate(rule, i, level);
+    std::vector<Rgb> samples(size_t(side) * side);
+    dH.evaluate_grid(at.data(), side, at.data(), side, samples.data());
+    parallel_for(side, [&](int i) {
+        for (int j = 0; j < side; ++j) {
+            Rgb& sample = samples[size_t(i) * side + j];
+            sample = rho.value(at[i], at[j]) * sample;
+        }
+    });
+    return l2_projection_of_samples(order_[surface], level, projection_points, samples.data());
 }
 
 double ProgressiveSolver::unshot_power(int surface) const {
