@@ -66,6 +66,19 @@ bool HiddenMask::hidden(double s, double t) const {
     return n_hidden_ > 0 && hidden_[texel(s, t)];
 }
 
+bool HiddenMask::mixed(double s0, double s1, double t0, double t1) const {
+    if (n_hidden_ == 0) return false;
+    const int i0 = texel(s0, t0) % n_, j0 = texel(s0, t0) / n_;
+    const int i1 = texel(s1, t1) % n_, j1 = texel(s1, t1) / n_;
+    bool seen_hidden = false, seen_visible = false;
+    for (int j = j0; j <= j1; ++j)
+        for (int i = i0; i <= i1; ++i) {
+            (hidden_[size_t(j) * n_ + i] ? seen_hidden : seen_visible) = true;
+            if (seen_hidden && seen_visible) return true;
+        }
+    return false;
+}
+
 Vec2 HiddenMask::substitute(double s, double t) const {
     if (n_hidden_ == 0) return {s, t};
     const int k = texel(s, t);

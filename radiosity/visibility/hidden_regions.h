@@ -33,6 +33,9 @@ public:
     /// (s, t) itself when visible; else the centre of the nearest visible texel (the whole
     /// surface hidden: (s, t) itself).
     Vec2 substitute(double s, double t) const;
+    /// True when the texels that meet the rectangle [s0, s1] x [t0, t1] of [0,1]^2 are some
+    /// hidden and some visible: the rectangle holds part of a hidden region's rim.
+    bool mixed(double s0, double s1, double t0, double t1) const;
 
 private:
     int texel(double s, double t) const;
