@@ -33,8 +33,10 @@ public:
     /// (s, t) itself when visible; else the centre of the nearest visible texel (the whole
     /// surface hidden: (s, t) itself).
     Vec2 substitute(double s, double t) const;
-    /// True when the texels that meet the rectangle [s0, s1] x [t0, t1] of [0,1]^2 are some
-    /// hidden and some visible: the rectangle holds part of a hidden region's rim.
+    /// True when the texels that meet the closed rectangle [s0, s1] x [t0, t1] of [0,1]^2 are
+    /// some hidden and some visible: the rectangle holds part of a hidden region's rim. A texel
+    /// that only touches the rectangle's far edge s1 or t1 counts (a dyadic cell then looks one
+    /// texel beyond its own: a rim found a little early, never missed).
     bool mixed(double s0, double s1, double t0, double t1) const;
 
 private:
