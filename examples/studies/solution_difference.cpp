@@ -70,8 +70,8 @@ int run(mbr::Args& args) {
         for (int k = 0; k < k_points; ++k) {
             const double u = mbr::uniform01(key, 2 * std::uint64_t(k));
             const double v = mbr::uniform01(key, 2 * std::uint64_t(k) + 1);
-            points.push_back(
-                {mbr::channel_sum(view_a.at(i, u, v)), mbr::channel_sum(view_b.at(i, u, v)), share, i, u, v});
+            points.push_back({mbr::channel_sum(view_a.at(i, u, v)),
+                              mbr::channel_sum(view_b.at(i, u, v)), share, i, u, v});
         }
     }
     if (points.empty()) throw mbr::UsageError("the scene has no surface that does not emit");

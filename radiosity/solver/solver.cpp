@@ -232,6 +232,16 @@ namespace {
 // only piecewise smooth).
 constexpr int projection_points = 8;
 
+// The coordinates along one direction of l2_projection's samples at `level`
+// (projection_sample_coordinate for every index).
+std::vector<double> projection_coordinates(int level) {
+    const GaussLegendre rule = gauss_legendre(projection_points);
+    std::vector<double> at(size_t(1 << level) * projection_points);
+    for (size_t i = 0; i < at.size(); ++i)
+        at[i] = projection_sample_coordinate(rule, int(i), level);
+    return at;
+}
+
 }  // namespace
 
 SplineField l2_projection_of_samples(int m, int level, int points, const Rgb* samples) {
@@ -315,15 +325,13 @@ SplineField l2_projection_of_samples(int m, int level, int points, const Rgb* sa
 }
 
 SplineField l2_projection(const std::function<Rgb(double, double)>& f, int m, int level) {
-    constexpr int points = projection_points;  // f at 8 x 8 Gauss points per cell
-    const int cells = 1 << level, side = cells * points;
-    const GaussLegendre rule = gauss_legendre(points);
-    std::vector<Rgb> samples(size_t(side) * side);
-    for (int i = 0; i < side; ++i)
-        for (int j = 0; j < side; ++j)
-            samples[size_t(i) * side + j] = f(projection_sample_coordinate(rule, i, level),
-                                              projection_sample_coordinate(rule, j, level));
-    return l2_projection_of_samples(m, level, points, samples.data());
+    // f at 8 x 8 Gauss points per cell.
+    const std::vector<double> at = projection_coordinates(level);
+    const size_t side = at.size();
+    std::vector<Rgb> samples(side * side);
+    for (size_t i = 0; i < side; ++i)
+        for (size_t j = 0; j < side; ++j) samples[i * side + j] = f(at[i], at[j]);
+    return l2_projection_of_samples(m, level, projection_points, samples.data());
 }
 
 double projection_sample_coordinate(const GaussLegendre& rule, int index, int level) {
@@ -551,10 +559,8 @@ SplineField ProgressiveSolver::reflected_field(int surface, const SplineField& d
     // The samples of l2_projection's rule, dH on the tensor grid (evaluate_grid: separable).
     const Texture& rho = scene_.material_of(surface).reflectance;
     const int level = std::min(dH.level(), SolverOptions::emission_level);
-    const int side = (1 << level) * projection_points;
-    const GaussLegendre rule = gauss_legendre(projection_points);
-    std::vector<double> at(side);
-    for (int i = 0; i < side; ++i) at[i] = projection_sample_coordinate(rule, i, level);
+    const std::vector<double> at = projection_coordinates(level);
+    const int side = static_cast<int>(at.size());
     std::vector<Rgb> samples(size_t(side) * side);
     dH.evaluate_grid(at.data(), side, at.data(), side, samples.data());
     parallel_for(side, [&](int i) {

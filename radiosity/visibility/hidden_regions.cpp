@@ -68,8 +68,8 @@ bool HiddenMask::hidden(double s, double t) const {
 
 bool HiddenMask::mixed(double s0, double s1, double t0, double t1) const {
     if (n_hidden_ == 0) return false;
-    const int i0 = texel(s0, t0) % n_, j0 = texel(s0, t0) / n_;
-    const int i1 = texel(s1, t1) % n_, j1 = texel(s1, t1) / n_;
+    const int first = texel(s0, t0), last = texel(s1, t1);
+    const int i0 = first % n_, j0 = first / n_, i1 = last % n_, j1 = last / n_;
     bool seen_hidden = false, seen_visible = false;
     for (int j = j0; j <= j1; ++j)
         for (int i = i0; i <= i1; ++i) {
