@@ -62,8 +62,9 @@ TEST_CASE("cost: the estimate grows with depth, order and tessellation", "[cost]
     const double at_24 = scene_cost(scene, o, 2).bytes;
     scene.settings.tessellation = 1024;
     // 1024^2 / 24^2 more curved facets: the polygons (2.3 MiB at 24) outgrow the rest (the
-    // program, fields, hidden regions and quadrature caches: about 68 MiB in all).
-    CHECK(scene_cost(scene, o, 2).bytes > 50 * at_24);
+    // program, fields, hidden regions, quadrature caches and the ambient gathers' kept hits:
+    // about 110 MiB in all).
+    CHECK(scene_cost(scene, o, 2).bytes > 40 * at_24);
 }
 
 TEST_CASE("cost: a run over the memory budget is refused before it starts", "[cost]") {

@@ -132,6 +132,18 @@ double ambient_gather_bytes(const std::vector<int>& order, int level, int rays) 
     return samples * (double(rays) * sizeof(GatherHit) + 6 * sizeof(Rgb) + sizeof(double) + 1);
 }
 
+double final_gather_bytes(const Scene& scene, const std::vector<int>& order, int level, int rays) {
+    const double diagonal = length(scene.bounds().extent());
+    double samples = 0;
+    for (size_t i = 0; i < scene.surfaces.size() && i < order.size(); ++i) {
+        const int l = final_gather_level(scene.surfaces[i].surface, diagonal, level);
+        if (l > level) samples += double(sample_side(order[i], l)) * sample_side(order[i], l);
+    }
+    rays =
+        gather_rays_per_point(std::max(ambient_min_rays, rays / final_gather_ray_share), samples);
+    return samples * (double(rays) * sizeof(GatherHit) + 4 * sizeof(Rgb) + sizeof(double) + 1);
+}
+
 int final_gather_level(const Surface& surface, double diagonal, int level) {
     const double cell = diagonal / final_gather_cells;
     const double size =
@@ -146,44 +158,53 @@ namespace {
 
 /// What the converged first gather hands the final gather: its level, the scene's size, where
 /// each surface's samples start, what they reflect (rho H), the share of their first bounce
-/// that came from emitting surfaces, their power weights, and which surfaces hold unshot light
-/// or emit.
+/// that came from emitting surfaces, and which surfaces hold unshot light or emit.
 struct FirstGather {
     int level;
     double scale;
     const std::vector<int>& first;
     const std::vector<Rgb>& reflected;
     const std::vector<Rgb>& lights;
-    const std::vector<double>& weight;
     const std::vector<bool>& has_unshot;
     const std::vector<bool>& emits;
 };
 
-/// The final gather (ambient_gather.h): the surfaces whose gathered radiosity reaches
-/// `threshold` gather once more at their final_gather_level, one bounce from U + R (R the
-/// converged gather's fields), and out's fields and power are replaced by theirs.
-void final_gather(const Scene& scene, const Octree& octree, const AmbientSources& sources,
-                  const FirstGather& g, double threshold, std::uint64_t seed, int rays_asked,
-                  AmbientGather* out) {
+/// The surface whose samples hold `item`, from the offsets `start`.
+int final_surface_of(const std::vector<int>& start, int item) {
+    return int(std::upper_bound(start.begin(), start.end(), item) - start.begin()) - 1;
+}
+
+/// The final gather's points (ambient_gather.h): per surface its level (-1: not refined) and
+/// where its samples start; per sample its kept hits (`rays` each), the part of H that does not
+/// change between passes (the unshot light of the surfaces that do not emit, met by the rays,
+/// and the emitters' first bounce as the first gather's field), rho, its power weight and
+/// whether it gathered.
+struct FinalPoints {
+    std::vector<int> level, start;
+    int rays = 0;
+    std::vector<GatherHit> hits;
+    std::vector<Rgb> fixed, rho;
+    std::vector<double> weight;
+    std::vector<std::uint8_t> gathers;
+};
+
+/// The surfaces the final gather refines (their gathered radiosity reaches `threshold` and
+/// their final_gather_level is finer than the gather's), their samples, and the rays cast once
+/// from each.
+FinalPoints final_points(const Scene& scene, const Octree& octree, const AmbientSources& sources,
+                         const FirstGather& g, double threshold, std::uint64_t seed,
+                         int rays_asked) {
     const int n = static_cast<int>(scene.surfaces.size());
     const int level = g.level;
-    const double scale = g.scale;
     const std::vector<int>& first = g.first;
-    const std::vector<Rgb>& reflected = g.reflected;
-    // R_j, what the converged gather makes every surface send, and which surfaces refine.
-    std::vector<PolynomialPatches> sent(n);
-    std::vector<bool> sends(n, false);
-    std::vector<int> final_level(n, -1);
+    FinalPoints f;
+    f.level.assign(n, -1);
     for (int j = 0; j < n; ++j) {
         double largest = 0;
         for (int item = first[j]; item < first[j + 1]; ++item)
-            largest = std::max(largest, max_abs(reflected[item]));
-        if (largest == 0) continue;
-        sends[j] = true;
-        sent[j] = PolynomialPatches(l2_projection_of_samples(
-            sources.order[j], level, sources.order[j], &reflected[first[j]]));
-        const int l = final_gather_level(scene.surfaces[j].surface, scale, level);
-        if (largest >= threshold && l > level) final_level[j] = l;
+            largest = std::max(largest, max_abs(g.reflected[item]));
+        const int l = final_gather_level(scene.surfaces[j].surface, g.scale, level);
+        if (largest > 0 && largest >= threshold && l > level) f.level[j] = l;
     }
     // The light of emitters still unshot stays at the first gather's level: a few rays a point
     // that meet small bright lights are noise at a fine level (corridor.mgf after 3 shots, 54
@@ -191,65 +212,97 @@ void final_gather(const Scene& scene, const Octree& octree, const AmbientSources
     std::vector<PolynomialPatches> lights(n);
     std::vector<bool> has_lights(n, false);
     for (int i = 0; i < n; ++i) {
-        if (final_level[i] < 0) continue;
+        if (f.level[i] < 0) continue;
         for (int item = first[i]; item < first[i + 1]; ++item)
             has_lights[i] = has_lights[i] || max_abs(g.lights[item]) > 0;
         if (has_lights[i])
             lights[i] = PolynomialPatches(l2_projection_of_samples(
                 sources.order[i], level, sources.order[i], &g.lights[first[i]]));
     }
-    std::vector<int> start(n + 1, 0);
+    f.start.assign(n + 1, 0);
     for (int i = 0; i < n; ++i) {
-        const int side = final_level[i] < 0 ? 0 : sample_side(sources.order[i], final_level[i]);
-        start[i + 1] = start[i] + side * side;
+        const int side = f.level[i] < 0 ? 0 : sample_side(sources.order[i], f.level[i]);
+        f.start[i + 1] = f.start[i] + side * side;
     }
-    const int n_samples = start[n];
-    if (n_samples == 0) return;
-    const int rays = gather_rays_per_point(
-        std::max(ambient_min_rays, rays_asked / final_gather_ray_share), n_samples);
-    auto surface_of = [&](int item) {
-        return int(std::upper_bound(start.begin(), start.end(), item) - start.begin()) - 1;
-    };
-    std::vector<Rgb> values(n_samples);         // rho H (H for an irradiance field)
-    std::vector<double> power(n_samples, 0.0);  // Gauss weight x A x rho H, summed
-    std::vector<std::uint8_t> gathers(n_samples, 0);
+    const int n_samples = f.start[n];
+    if (n_samples == 0) return f;
+    f.rays = gather_rays_per_point(std::max(ambient_min_rays, rays_asked / final_gather_ray_share),
+                                   n_samples);
+    f.hits.assign(size_t(n_samples) * f.rays, GatherHit{-1, 0, 0});
+    f.fixed.resize(n_samples);
+    f.rho.resize(n_samples);
+    f.weight.assign(n_samples, 0.0);
+    f.gathers.assign(n_samples, 0);
     parallel_for(n_samples, [&](int item) {
-        const int i = surface_of(item), k = item - start[i];
+        const int i = final_surface_of(f.start, item), k = item - f.start[i];
         const Surface& surface = scene.surfaces[i].surface;
-        const GatherSample at = gather_sample(surface, sources.order[i], final_level[i], k);
-        const double s = at.s, t = at.t;
+        const GatherSample at = gather_sample(surface, sources.order[i], f.level[i], k);
+        f.weight[item] = at.weight;
+        f.rho[item] = scene.material_of(i).reflectance.value(at.s, at.t);
         const std::optional<GatherOrigin> o = gather_origin(
-            surface, i < int(sources.hidden.size()) ? &sources.hidden[i] : nullptr, s, t, scale,
-            hash_seed(seed ^ 0x66696e616cULL, std::uint64_t(i), std::uint64_t(k)));
+            surface, i < int(sources.hidden.size()) ? &sources.hidden[i] : nullptr, at.s, at.t,
+            g.scale, hash_seed(seed ^ 0x66696e616cULL, std::uint64_t(i), std::uint64_t(k)));
         if (!o) return;
+        GatherHit* kept = &f.hits[size_t(item) * f.rays];
         Rgb sum;
-        for (int r = 0; r < rays; ++r) {
-            const std::optional<RayHit> h = gather_ray(octree, *o, r, rays);
+        for (int r = 0; r < f.rays; ++r) {
+            const std::optional<RayHit> h = gather_ray(octree, *o, r, f.rays);
             if (!h) continue;
+            kept[r] = {h->surface, float(h->u), float(h->v)};
             if (g.has_unshot[h->surface] && !g.emits[h->surface])
                 sum += sources.unshot[h->surface].evaluate(h->u, h->v);
-            if (sends[h->surface]) sum += sent[h->surface](h->u, h->v);
         }
-        const Rgb H = (1.0 / rays) * sum + (has_lights[i] ? lights[i](s, t) : Rgb{});
-        const Rgb rho = scene.material_of(i).reflectance.value(s, t);
-        const Rgb rhoH = rho * H;
-        values[item] = sources.irradiance[i] ? H : rhoH;
-        power[item] = at.weight * (rhoH.r + rhoH.g + rhoH.b);
-        gathers[item] = 1;
+        f.fixed[item] = (1.0 / f.rays) * sum + (has_lights[i] ? lights[i](at.s, at.t) : Rgb{});
+        f.gathers[item] = 1;
+    });
+    return f;
+}
+
+/// What one pass of the final gather makes of the surfaces it refines: per surface the field
+/// to add (H for an irradiance field, else rho H), what the surface sends (rho H) and the
+/// power it adds; the rays it counts.
+struct FinalGather {
+    std::vector<SplineField> added, sent;
+    std::vector<double> power;
+    long rays = 0;
+};
+
+/// One pass of the final gather: H(p) = the fixed part + mean sent_j at the kept hits.
+FinalGather final_pass(const Scene& scene, const AmbientSources& sources, const FinalPoints& f,
+                       const std::vector<PolynomialPatches>& sent, const std::vector<bool>& sends) {
+    const int n = static_cast<int>(scene.surfaces.size());
+    FinalGather result{std::vector<SplineField>(n), std::vector<SplineField>(n),
+                       std::vector<double>(n, 0.0)};
+    const int n_samples = f.start[n];
+    if (n_samples == 0) return result;
+    std::vector<Rgb> values(n_samples);   // rho H (H for an irradiance field)
+    std::vector<Rgb> leaving(n_samples);  // rho H
+    parallel_for(n_samples, [&](int item) {
+        if (!f.gathers[item]) return;
+        const int i = final_surface_of(f.start, item);
+        const GatherHit* kept = &f.hits[size_t(item) * f.rays];
+        Rgb sum;
+        for (int r = 0; r < f.rays; ++r)
+            if (kept[r].surface >= 0 && sends[kept[r].surface])
+                sum += sent[kept[r].surface](kept[r].u, kept[r].v);
+        const Rgb H = f.fixed[item] + (1.0 / f.rays) * sum;
+        leaving[item] = f.rho[item] * H;
+        values[item] = sources.irradiance[i] ? H : leaving[item];
     });
     for (int i = 0; i < n; ++i) {
-        if (final_level[i] < 0) continue;
-        // What the first gather added on i leaves the power, the final gather's enters it.
-        for (int item = first[i]; item < first[i + 1]; ++item)
-            out->power -=
-                g.weight[item] * (reflected[item].r + reflected[item].g + reflected[item].b);
-        for (int item = start[i]; item < start[i + 1]; ++item) {
-            out->power += power[item];
-            out->rays += gathers[item] ? rays : 0;
+        if (f.level[i] < 0) continue;
+        for (int item = f.start[i]; item < f.start[i + 1]; ++item) {
+            const Rgb& rhoH = leaving[item];
+            result.power[size_t(i)] += f.weight[item] * (rhoH.r + rhoH.g + rhoH.b);
+            result.rays += f.gathers[item] ? f.rays : 0;
         }
-        out->added[i] = l2_projection_of_samples(sources.order[i], final_level[i], sources.order[i],
-                                                 &values[start[i]]);
+        const int m = sources.order[i];
+        result.added[size_t(i)] = l2_projection_of_samples(m, f.level[i], m, &values[f.start[i]]);
+        result.sent[size_t(i)] =
+            sources.irradiance[i] ? l2_projection_of_samples(m, f.level[i], m, &leaving[f.start[i]])
+                                  : result.added[size_t(i)];
     }
+    return result;
 }
 
 }  // namespace
@@ -370,11 +423,72 @@ AmbientGather gather_ambient(const Scene& scene, const Octree& octree,
             out.added[i] = l2_projection_of_samples(sources.order[i], level, sources.order[i],
                                                     &samples[first[i]]);
     }
-    if (final_threshold > 0)
-        final_gather(
-            scene, octree, sources,
-            FirstGather{level, scale, first, reflected, first_lights, weight, has_unshot, emits},
-            final_threshold, seed, rays_asked, &out);
+    if (!(final_threshold > 0)) return out;
+    const FirstGather g{level, scale, first, reflected, first_lights, has_unshot, emits};
+    const FinalPoints points =
+        final_points(scene, octree, sources, g, final_threshold, seed, rays_asked);
+    if (points.start[n] == 0) return out;
+    // What every surface sends after the converged gather: R_j, its level-`level` field.
+    std::vector<PolynomialPatches> sent(n);
+    std::vector<bool> sends(n, false);
+    for (int j = 0; j < n; ++j) {
+        for (int item = first[j]; item < first[j + 1]; ++item)
+            sends[j] = sends[j] || max_abs(reflected[item]) > 0;
+        if (sends[j])
+            sent[j] = PolynomialPatches(l2_projection_of_samples(
+                sources.order[j], level, sources.order[j], &reflected[first[j]]));
+    }
+    FinalGather refined = final_pass(scene, sources, points, sent, sends);
+    // The final gather once more through the same hits, from what the refined surfaces send
+    // after the first pass: a small refined surface beside a large one sees the large one's
+    // ambient light at the large one's final level, not spread over its level-`level` cells.
+    for (int j = 0; j < n; ++j)
+        if (points.level[j] >= 0) {
+            sends[j] = !refined.sent[j].empty();
+            if (sends[j]) sent[j] = PolynomialPatches(refined.sent[j]);
+        }
+    refined = final_pass(scene, sources, points, sent, sends);
+    out.rays += refined.rays;
+    for (int i = 0; i < n; ++i) {
+        if (points.level[i] < 0) continue;
+        // What the first gather added on i leaves the power, the final gather's enters it.
+        for (int item = first[i]; item < first[i + 1]; ++item)
+            out.power -= weight[item] * (reflected[item].r + reflected[item].g + reflected[item].b);
+        out.power += refined.power[size_t(i)];
+        out.added[i] = refined.added[size_t(i)];
+        sends[i] = !refined.sent[i].empty();
+        if (sends[i]) sent[i] = PolynomialPatches(refined.sent[i]);
+    }
+    // The last bounce (beyond the final gather): the surfaces it did not refine take one more
+    // step of the iteration through their kept hits, from what every surface sends now, the
+    // refined ones at their finer level. Without it a small surface beside a large one saw the
+    // large one's ambient light spread over its level-`level` cells (a luminaire's housing 4 cm
+    // under a ceiling, docs/method.md, "The final gather").
+    parallel_for(n_samples, [&](int item) {
+        const int i = surface_of(item);
+        if (!gathers[item] || points.level[i] >= 0) return;
+        const GatherHit* kept = &hits[size_t(item) * rays];
+        Rgb sum;
+        for (int r = 0; r < rays; ++r)
+            if (kept[r].surface >= 0 && sends[kept[r].surface])
+                sum += sent[kept[r].surface](kept[r].u, kept[r].v);
+        H[item] = first_bounce[item] + (1.0 / rays) * sum;
+    });
+    for (int i = 0; i < n; ++i) {
+        if (points.level[i] >= 0) continue;
+        bool any = false;
+        for (int item = first[i]; item < first[i + 1]; ++item) {
+            const Rgb old_reflected = reflected[item];
+            reflected[item] = rho[item] * H[item];
+            out.power += weight[item] * (reflected[item].r + reflected[item].g + reflected[item].b -
+                                         old_reflected.r - old_reflected.g - old_reflected.b);
+            samples[item] = sources.irradiance[i] ? H[item] : reflected[item];
+            any = any || max_abs(samples[item]) > 0;
+        }
+        out.added[i] = any ? l2_projection_of_samples(sources.order[i], level, sources.order[i],
+                                                      &samples[first[i]])
+                           : SplineField();
+    }
     return out;
 }
 

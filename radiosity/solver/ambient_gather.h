@@ -60,6 +60,11 @@ double ambient_gather_bytes(const std::vector<int>& order, int level, int rays);
 /// The finest level the gather takes.
 constexpr int max_ambient_level = 4;
 
+/// The memory the final gather holds besides the gather's, at most: per sample of every
+/// surface it could refine (at its final_gather_level, when finer than `level`) its kept hits
+/// (the two passes share them) and its values.
+double final_gather_bytes(const Scene& scene, const std::vector<int>& order, int level, int rays);
+
 /// The gather. At each of the m x m Gauss-Legendre points p of every level-`level` cell of every
 /// surface with a reflectance (a hidden point at its substitute),
 /// gather_rays_per_point(rays, points) cosine-distributed directions (a Hammersley set
@@ -80,7 +85,11 @@ constexpr int max_ambient_level = 4;
 /// a point (final_gather_ray_share), one bounce from what the converged gather makes every surface
 /// send (U_j + R_j): the ambient light of a large surface then follows the shadows of what stands
 /// near it (a block a third of a unit from a wall ten units wide) instead of one field over half
-/// the wall.
+/// the wall. Its points keep their hits and gather a second time through them, from what the
+/// refined surfaces send after the first pass; then the surfaces it did not refine take one
+/// more step of the iteration through their own kept hits, from what every surface sends now
+/// (the last bounce): a small surface beside a large one sees the large one's ambient light
+/// at the large one's final level (a luminaire's housing under a ceiling).
 AmbientGather gather_ambient(const Scene& scene, const Octree& octree,
                              const AmbientSources& sources, int rays, int level = 0,
                              std::uint64_t seed = 1, double final_threshold = 0);

@@ -145,10 +145,14 @@ CostEstimate scene_cost(const Scene& scene, const SolverOptions& options, int th
                       sizeof(int) +
                   pairs * 96.0;
     // The ambient gather's rays at the end (ambient_gather.h).
-    const double gather = options.ambient && options.ambient_rays > 0
-                              ? ambient_gather_bytes(orders, options.ambient_level,
-                                                     options.ambient_rays)
-                              : 0.0;
+    const bool gathers = options.ambient && options.ambient_rays > 0;
+    const double gather =
+        gathers
+            ? ambient_gather_bytes(orders, options.ambient_level, options.ambient_rays) +
+                  (options.ambient_final ? final_gather_bytes(scene, orders, options.ambient_level,
+                                                              options.ambient_rays)
+                                         : 0.0)
+            : 0.0;
     CostEstimate c;
     c.bytes = program_bytes + fields + hidden + transfers + caches + polygons + textures +
               occluder_lists + gather;
