@@ -1,6 +1,7 @@
 // test/test_resolution.cpp - a receiver too coarse for a light's peak is an error before any
 // work (radiosity/solver/resolution.h; issue 19, "a large receiver loses the light").
 #include <catch2/catch.hpp>
+#include <cmath>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -72,6 +73,33 @@ TEST_CASE("resolution: a floor whose finest cells are wider than the lamp's spot
     }
     // The 1e8 floor of the coordinate limit: an error too, never a NaN or a dark floor.
     CHECK_THROWS_AS(check_resolution(lamp_over_floor(5e7), 12), InputError);
+}
+
+TEST_CASE("resolution: a strip's peak is as narrow as the strip", "[resolution]") {
+    // A 1.4 x 0.08 strip lamp 4 cm under a 3.7 x 5.3 ceiling: across the strip its peak is
+    // about 0.08 wide, and the ceiling's cells at max_depth 6 are 5.8 x 8.3 cm (measured: -17 %
+    // at the peak's centre, from -97 to +687 % beside it; within 2 % of the centre at depth 7,
+    // 0.5 % everywhere at depth 8). A square lamp of the same area (0.335 wide) is held at 6.
+    auto ceiling_over = [](const std::string& lamp) {
+        std::istringstream in(
+            "material ceil reflectance 0.75 0.75 0.75\n"
+            "material lamp emission 1 1 1\n"
+            "quad ceiling ceil 0 0.2 2.8  0 5.5 2.8  3.7 5.5 2.8  3.7 0.2 2.8\n" +
+            lamp);
+        return parse_scene(in, "ceiling.scene");
+    };
+    const Scene strip = ceiling_over(
+        "quad strip lamp 1.1 2.86 2.76  2.5 2.86 2.76  2.5 2.94 2.76  1.1 2.94 2.76\n");
+    const std::vector<UnresolvedLight> u = unresolved_lights(strip, 6);
+    REQUIRE(u.size() == 1);
+    CHECK(u[0].spot == Approx(0.08).epsilon(1e-9));
+    CHECK(u[0].needed_depth == 7);
+    CHECK(unresolved_lights(strip, 7).empty());
+    const double side = std::sqrt(1.4 * 0.08), x = 1.8 - side / 2, y = 2.9 - side / 2;
+    std::ostringstream square;
+    square << "quad square lamp " << x << " " << y << " 2.76  " << x + side << " " << y << " 2.76  "
+           << x + side << " " << y + side << " 2.76  " << x << " " << y + side << " 2.76\n";
+    CHECK(unresolved_lights(ceiling_over(square.str()), 6).empty());
 }
 
 TEST_CASE("resolution: what the check leaves alone", "[resolution]") {
