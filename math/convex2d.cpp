@@ -101,6 +101,20 @@ Rect bounding_rect(const ConvexPolygon& polygon) {
     return r;
 }
 
+double narrowest_width(const ConvexPolygon& polygon) {
+    const size_t n = polygon.size();
+    double narrowest = HUGE_VAL;
+    for (size_t i = 0; i < n; ++i) {
+        const Vec2 a = polygon[i], edge = polygon[(i + 1) % n] - a;
+        const double len = std::hypot(edge.x, edge.y);
+        if (!(len > 0)) continue;
+        double farthest = 0;
+        for (const Vec2& q : polygon) farthest = std::max(farthest, std::fabs(cross(edge, q - a)));
+        narrowest = std::min(narrowest, farthest / len);
+    }
+    return narrowest;
+}
+
 bool is_sliver(const ConvexPolygon& polygon, double min_width, double min_extent) {
     if (polygon.size() < 3) return true;
     const Rect box = bounding_rect(polygon);

@@ -44,6 +44,11 @@ std::vector<ConvexPolygon> subtract(const ConvexPolygon& a, const ConvexPolygon&
 /// The smallest axis-aligned rectangle holding the polygon (x0 > x1 when it is empty).
 Rect bounding_rect(const ConvexPolygon& polygon);
 
+/// The narrowest width of a convex polygon (either orientation): the least, over its edges, of
+/// the farthest corner's distance from the edge's line. A square's side, a strip's width
+/// (the resolution check's width of a lamp, the narrow shadow rule's width of a shadow).
+double narrowest_width(const ConvexPolygon& polygon);
+
 /// True when the polygon is at most `min_width` wide or its bounding box at most `min_extent`
 /// across: fewer than three vertices, an area at most min_width times the box's diagonal (a
 /// strip of length l and width w has area l w and diagonal about l), or a speck. A small but

@@ -545,3 +545,20 @@ TEST_CASE("convex2d: the symmetric triangle rules integrate monomials of their d
     CHECK(triangle_rule_of_degree_2n_minus_2(5).points.size() == 25);
     CHECK_THROWS(symmetric_triangle_rule(3));
 }
+
+TEST_CASE(
+    "convex2d: narrowest_width is a square's side, a strip's width, a triangle's least height",
+    "[convex2d]") {
+    CHECK(narrowest_width(unit_square) == Approx(1));
+    const ConvexPolygon strip{{0, 0}, {1.4, 0}, {1.4, 0.08}, {0, 0.08}};
+    CHECK(narrowest_width(strip) == Approx(0.08));
+    // Clockwise, the same.
+    CHECK(narrowest_width(ConvexPolygon(strip.rbegin(), strip.rend())) == Approx(0.08));
+    // A strip turned by 30 degrees keeps its width.
+    ConvexPolygon turned;
+    const double c = std::cos(M_PI / 6), s = std::sin(M_PI / 6);
+    for (const Vec2& p : strip) turned.push_back({c * p.x - s * p.y, s * p.x + c * p.y});
+    CHECK(narrowest_width(turned) == Approx(0.08));
+    // The triangle (0,0), (4,0), (0,3): its heights are 3, 4 and 12/5.
+    CHECK(narrowest_width({{0, 0}, {4, 0}, {0, 3}}) == Approx(2.4));
+}

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "math/check.h"
+#include "math/convex2d.h"
 #include "radiosity/transfer/form_factor.h"
 #include "radiosity/transfer/oracle.h"
 #include "radiosity/visibility/visible_parts.h"
@@ -14,26 +15,6 @@
 namespace mbr {
 
 namespace {
-
-/// The narrowest width of a convex outline: the least, over its edges, of the farthest
-/// corner's distance from the edge's line. A square's side; a strip's width, across which its
-/// peak is narrow (a 1.4 x 0.08 strip 4 cm under a ceiling: the ceiling at max_depth 6, cells
-/// 5.8 x 8.3 cm, read -17 % at the peak's centre and rang from -97 to +687 % beside it, with
-/// no word while the check took the square root of the strip's area, 0.33, for its size;
-/// docs/method.md, "Known wrong answers").
-double narrowest_width(const ConvexPolygon& outline) {
-    const size_t n = outline.size();
-    double narrowest = HUGE_VAL;
-    for (size_t i = 0; i < n; ++i) {
-        const Vec2 a = outline[i], edge = outline[(i + 1) % n] - a;
-        const double len = std::hypot(edge.x, edge.y);
-        if (!(len > 0)) continue;
-        double farthest = 0;
-        for (const Vec2& q : outline) farthest = std::max(farthest, std::fabs(cross(edge, q - a)));
-        narrowest = std::min(narrowest, farthest / len);
-    }
-    return narrowest;
-}
 
 /// What the check measures on a cell of the receiver: its size (its longer side), and the width
 /// of the emitter's peak there, max(d, the emitter's narrowest width), d the distance to the
@@ -108,6 +89,11 @@ bool in_front(const Surface& receiver, const Surface& emitter) {
     return lowest > 1e-9 * scale;
 }
 
+/// The walk towards the emitter's peak. DESIGN: the peak's width is the emitter's narrowest
+/// width, across which a strip's peak is narrow (a 1.4 x 0.08 strip 4 cm under a ceiling: at
+/// max_depth 6, cells 5.8 x 8.3 cm, the ceiling read -17 % at the peak's centre and rang from
+/// -97 to +687 % beside it, with no word while the check took the square root of the strip's
+/// area, 0.33; docs/method.md, "Known wrong answers").
 Walk walk_at(const Surface& receiver, const ShooterPlane& emitter, int depth) {
     Walk w{receiver, emitter, narrowest_width(emitter.outline), depth};
     walk(w, Rect{0, 1, 0, 1}, 0);
