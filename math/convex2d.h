@@ -45,8 +45,8 @@ std::vector<ConvexPolygon> subtract(const ConvexPolygon& a, const ConvexPolygon&
 Rect bounding_rect(const ConvexPolygon& polygon);
 
 /// The narrowest width of a convex polygon (either orientation): the least, over its edges, of
-/// the farthest corner's distance from the edge's line. A square's side, a strip's width
-/// (the resolution check's width of a lamp, the narrow shadow rule's width of a shadow).
+/// the farthest corner's distance from the edge's line. A square's side, a strip's width (the
+/// resolution check's width of a lamp, radiosity/solver/resolution.h).
 double narrowest_width(const ConvexPolygon& polygon);
 
 /// True when the polygon is at most `min_width` wide or its bounding box at most `min_extent`
