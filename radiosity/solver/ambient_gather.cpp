@@ -118,6 +118,17 @@ std::optional<RayHit> gather_ray(const Octree& octree, const GatherOrigin& o, in
     return RayHit{hit->surface, hit->uv.x, hit->uv.y};
 }
 
+/// The mean over a sample's `rays` kept hits of what the surfaces hit send: sent[j] at the hit
+/// on j where sends[j], nothing for a miss.
+Rgb mean_sent(const GatherHit* kept, int rays, const std::vector<PolynomialPatches>& sent,
+              const std::vector<bool>& sends) {
+    Rgb sum;
+    for (int r = 0; r < rays; ++r)
+        if (kept[r].surface >= 0 && sends[kept[r].surface])
+            sum += sent[kept[r].surface](kept[r].u, kept[r].v);
+    return (1.0 / rays) * sum;
+}
+
 }  // namespace
 
 int gather_rays_per_point(int rays, double samples) {
@@ -280,12 +291,8 @@ FinalGather final_pass(const Scene& scene, const AmbientSources& sources, const 
     parallel_for(n_samples, [&](int item) {
         if (!f.gathers[item]) return;
         const int i = final_surface_of(f.start, item);
-        const GatherHit* kept = &f.hits[size_t(item) * f.rays];
-        Rgb sum;
-        for (int r = 0; r < f.rays; ++r)
-            if (kept[r].surface >= 0 && sends[kept[r].surface])
-                sum += sent[kept[r].surface](kept[r].u, kept[r].v);
-        const Rgb H = f.fixed[item] + (1.0 / f.rays) * sum;
+        const Rgb H =
+            f.fixed[item] + mean_sent(&f.hits[size_t(item) * f.rays], f.rays, sent, sends);
         leaving[item] = f.rho[item] * H;
         values[item] = sources.irradiance[i] ? H : leaving[item];
     });
@@ -395,12 +402,8 @@ AmbientGather gather_ambient(const Scene& scene, const Octree& octree,
         }
         parallel_for(n_samples, [&](int item) {
             if (!gathers[item]) return;
-            const GatherHit* kept = &hits[size_t(item) * rays];
-            Rgb sum;
-            for (int r = 0; r < rays; ++r)
-                if (kept[r].surface >= 0 && has_bounce[kept[r].surface])
-                    sum += bounce[kept[r].surface](kept[r].u, kept[r].v);
-            H[item] = first_bounce[item] + (1.0 / rays) * sum;
+            H[item] = first_bounce[item] +
+                      mean_sent(&hits[size_t(item) * rays], rays, bounce, has_bounce);
         });
         ++out.iterations;
         const double next = added_power();
@@ -467,12 +470,7 @@ AmbientGather gather_ambient(const Scene& scene, const Octree& octree,
     parallel_for(n_samples, [&](int item) {
         const int i = surface_of(item);
         if (!gathers[item] || points.level[i] >= 0) return;
-        const GatherHit* kept = &hits[size_t(item) * rays];
-        Rgb sum;
-        for (int r = 0; r < rays; ++r)
-            if (kept[r].surface >= 0 && sends[kept[r].surface])
-                sum += sent[kept[r].surface](kept[r].u, kept[r].v);
-        H[item] = first_bounce[item] + (1.0 / rays) * sum;
+        H[item] = first_bounce[item] + mean_sent(&hits[size_t(item) * rays], rays, sent, sends);
     });
     for (int i = 0; i < n; ++i) {
         if (points.level[i] >= 0) continue;
