@@ -91,10 +91,10 @@ std::vector<SurfaceLocation> locate_probe_points(const Scene& scene,
 /// B at a located point, eq. (2): view.at(surface, u, v), except where the point is the image of
 /// a whole parameter edge (a disk's centre, a sphere's pole: the edge u = 0 of a disk with r0 =
 /// 0). There a field's value depends on the direction the point is approached from (on the room's
-/// stool the values around its underside's centre spread by 9 % of their mean), and the located (u, v) picks
-/// one direction arbitrarily; the mean along that edge is returned instead, the limit of B's
-/// means over small circles around the point (8-point Gauss-Legendre on each of the field's
-/// 2^level cells along the edge: exact for orders up to 16).
+/// stool the values around its underside's centre spread by 9 % of their mean), and the located
+/// (u, v) picks one direction arbitrarily; the mean along that edge is returned instead, the
+/// limit of B's means over small circles around the point (8-point Gauss-Legendre on each of the
+/// field's 2^level cells along the edge: exact for orders up to 16).
 Rgb radiosity_at(const RadiosityView& view, const Scene& scene, const SurfaceLocation& at);
 
 /// Writes `name,B_r,B_g,B_b` and one row per point (%.9g: doubles' values to 9 digits).

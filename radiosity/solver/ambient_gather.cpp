@@ -215,7 +215,7 @@ FinalPoints final_points(const Scene& scene, const Octree& octree, const Ambient
         for (int item = first[j]; item < first[j + 1]; ++item)
             largest = std::max(largest, max_abs(g.reflected[item]));
         const int l = final_gather_level(scene.surfaces[j].surface, g.scale, level);
-        if (largest > 0 && largest >= threshold && l > level) f.level[j] = l;
+        if (largest >= threshold && l > level) f.level[j] = l;  // threshold > 0
     }
     // The light of emitters still unshot stays at the first gather's level: a few rays a point
     // that meet small bright lights are noise at a fine level (corridor.mgf after 3 shots, 54
