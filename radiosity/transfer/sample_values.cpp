@@ -39,12 +39,15 @@ IncrementIntegrator::IncrementIntegrator(const Shooter& shooter, const Quadratur
     }
     if (occlusion && !occlusion->clear()) occlusion_ = occlusion;
     analytic_ = planar_ && unshot_constant_ && options.analytic;
-    if (planar_ && !unshot_constant_) unshot_patches_ = PolynomialPatches(shooter.unshot);
+    if (planar_ && !unshot_constant_)
+        unshot_patches_ = shooter.patches
+                              ? shooter.patches
+                              : std::make_shared<const PolynomialPatches>(shooter.unshot);
 }
 
 Rgb IncrementIntegrator::shooter_radiosity(double u, double v) const {
     if (unshot_constant_) return shooter_.unshot.coefficient(0, 0);
-    if (planar_) return unshot_patches_(u, v);
+    if (planar_) return (*unshot_patches_)(u, v);
     return shooter_.unshot.evaluate(u, v);
 }
 
@@ -176,7 +179,7 @@ Rgb IncrementIntegrator::triangle_value(const SurfacePoint& p, const ShadowTrian
             // the bilinear map is nearly affine over one triangle).
             const Vec2 guess = t.uv_a + xi * (t.uv_b - t.uv_a) + eta * (t.uv_c - t.uv_a);
             const Vec2 uv = plane_.refine_parameters(X, plane_.refine_parameters(X, guess));
-            B = unshot_patches_(uv.x, uv.y);
+            B = (*unshot_patches_)(uv.x, uv.y);
         }
         sum += (weights[q] * t.jacobian * F) * (B - b_star);
     }
@@ -362,7 +365,7 @@ Rgb IncrementIntegrator::pieces_value(const SurfacePoint& p,
                 Rgb B = constant_b;
                 if (!unshot_constant_) {
                     const Vec2 uv = plane_.parameters(X);
-                    B = unshot_patches_(uv.x, uv.y);
+                    B = (*unshot_patches_)(uv.x, uv.y);
                 }
                 sum += (rule.weights[q] * jacobian * F) * (B - b_star_);
             }
@@ -401,7 +404,7 @@ IncrementIntegrator::PointSpan IncrementIntegrator::horizon_points(const QuadCel
                 Rgb B = constant_b;
                 if (!unshot_constant_) {
                     const Vec2 uv = plane_.parameters(X);
-                    B = unshot_patches_(uv.x, uv.y);
+                    B = (*unshot_patches_)(uv.x, uv.y);
                 }
                 pts.push_back({plane_.to_space(X), plane_.normal, w * B, w});
             }

@@ -7,6 +7,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <unordered_map>
 #include <vector>
@@ -22,10 +23,13 @@
 namespace mbr {
 
 /// The shooting surface of one transfer and its unshot radiosity (already at the level the
-/// caller wants; section 6 coarsens it first).
+/// caller wants; section 6 coarsens it first). `patches` (optional) is `unshot` as polynomial
+/// pieces, built once for all the shot's receivers (make_shooter); without it each transfer's
+/// integrator builds its own.
 struct Shooter {
     const Surface* surface = nullptr;
     SplineField unshot;
+    std::shared_ptr<const PolynomialPatches> patches;
 };
 
 /// The near-field guard of the adaptive quadrature of (21): a shooter cell whose extent exceeds
@@ -260,7 +264,7 @@ private:
     double mixed_tolerance_ = 0;        // integrate's tolerance with ray visibility, else 0
     std::uint64_t pieces_key_ = ~0ULL;  // the cut cell whose pieces are in pieces_
     std::vector<ConvexPolygon> pieces_;
-    PolynomialPatches unshot_patches_;     // B_h for scattered points (cut pieces)
+    std::shared_ptr<const PolynomialPatches> unshot_patches_;  // B_h at scattered points
     std::optional<Plane> receiver_plane_;  // set_receiver_plane
     /// The front pieces' points of cells only the (fixed) horizon cuts, per cell and rule.
     std::unordered_map<std::uint64_t, std::vector<ShooterPoint>> horizon_cache_;
