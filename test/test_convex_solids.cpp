@@ -259,3 +259,53 @@ TEST_CASE("convex solids: a pair's candidates split into whole solids and loose 
     CHECK(ctx.solid_ids == std::vector<int>{0});
     CHECK(ctx.loose == std::vector<int>{6, 8, 11});
 }
+
+TEST_CASE("convex solids: many faces but few solids are projected and not ray-cast",
+          "[shadow][convex_solids]") {
+    // Eight closed boxes (48 faces, more than exact_limit) between a ceiling shooter and a floor
+    // receiver: exact visibility counts its shadow casters by solids (8), so every receiving
+    // point projects silhouettes instead of casting one ray per quadrature node (use_rays). The
+    // shadows must say what rays say: a shooter point lies in a shadow exactly when the segment
+    // from the receiving point to it is blocked.
+    const std::vector<Vec3> ceiling{{0, 3, 0}, {5, 3, 0}, {5, 3, 5}, {0, 3, 5}};
+    const std::vector<Vec3> floor{{0, 0, 0}, {0, 0, 5}, {5, 0, 5}, {5, 0, 0}};
+    const Surface shooter = Surface::planar_quad(ceiling[0], ceiling[1], ceiling[2], ceiling[3]);
+    const Surface receiver = Surface::planar_quad(floor[0], floor[1], floor[2], floor[3]);
+    std::vector<Polygon> polygons;
+    polygons.emplace_back(ceiling, no_uv(4), 0);
+    polygons.emplace_back(floor, no_uv(4), 1);
+    for (int b = 0; b < 8; ++b) {
+        const double x = 0.3 + 0.6 * b, z = b % 2 == 0 ? 1.5 : 3.0;
+        for (Polygon& f : box_faces({x, 1.0, z}, {x + 0.35, 1.6, z + 0.5}, 2 + 6 * b, true))
+            polygons.push_back(f);
+    }
+    const Octree octree(polygons);
+    const ConvexSolids solids = find_convex_solids(polygons);
+    REQUIRE(solids.solids.size() == 8);
+    OcclusionContext ctx = make_occlusion_context(octree, shooter, 0, receiver, 1, 0);
+    attach_solids(ctx, solids);
+    REQUIRE(static_cast<int>(ctx.candidates.size()) > exact_limit);
+    REQUIRE(ctx.solid_ids.size() + ctx.loose.size() <= size_t(exact_limit));
+    const ShooterPlane plane = make_shooter_plane(shooter);
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<double> u(0.01, 4.99), w(0, 1);
+    int shadowed = 0, lit = 0;
+    for (int k = 0; k < 40; ++k) {
+        const Vec3 p{u(rng), 0, u(rng)};
+        const BlockedView view = blocked_view(plane, p, {0, 1, 0}, &ctx);
+        CHECK_FALSE(view.use_rays);
+        CHECK(view.shadows.size() <= 8);
+        for (int j = 0; j < 50; ++j) {
+            const Vec3 x = shooter.point(w(rng), w(rng));
+            const Vec2 q{dot(x - plane.origin, plane.e1), dot(x - plane.origin, plane.e2)};
+            bool in_shadow = false;
+            for (const ConvexPolygon& s : view.shadows) in_shadow = in_shadow || contains(s, q);
+            const Ray segment{p, x - p, 1e-9, 1 - 1e-9};
+            CAPTURE(p, x);
+            CHECK(in_shadow == octree.any_hit(segment));
+            ++(in_shadow ? shadowed : lit);
+        }
+    }
+    CHECK(shadowed > 100);
+    CHECK(lit > 100);
+}

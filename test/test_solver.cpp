@@ -835,10 +835,11 @@ TEST_CASE("hidden regions: a hidden region far from every contact grows from its
     CHECK(texels_differing(full, grown) == 0);
 }
 
-TEST_CASE("shadows auto: exact between few occluding surfaces, the paper's between many",
+TEST_CASE("shadows auto: exact between few shadow casters, the paper's between many",
           "[solver][shadows]") {
-    // A lamp above a floor with n small boxes between them (six surfaces each): the lamp-to-
-    // floor pair has 6 n occluding surfaces, 6 for one box, 24 for four.
+    // A lamp above a floor with n small boxes between them (six surfaces each, one convex solid
+    // each): the lamp-to-floor pair has n shadow casters (shadow_casters), though 6 n occluding
+    // surfaces: 1 and 4 boxes stay exact, 20 take the fractions.
     auto scene_with = [](int boxes) {
         std::ostringstream text;
         text << "material white reflectance 0.5 0.5 0.5\n"
@@ -846,31 +847,35 @@ TEST_CASE("shadows auto: exact between few occluding surfaces, the paper's betwe
                 "rectangle floor white -2 0 -2  0 0 4  4 0 0\n"
                 "rectangle lamp lamp -0.5 2 -0.5  1 0 0  0 0 1\n";
         for (int b = 0; b < boxes; ++b) {
-            const double x = -1.2 + 0.8 * b;
-            text << "box block" << b << " white " << x << " 0.8 -0.2 " << x + 0.3 << " 1.1 0.1\n";
+            // One row of up to four, as before; twenty on a 5 x 4 grid under the lamp.
+            const double x = boxes <= 4 ? -1.2 + 0.8 * b : -1.1 + 0.45 * (b % 5);
+            const double z = boxes <= 4 ? -0.2 : -1.1 + 0.55 * (b / 5);
+            const double side = boxes <= 4 ? 0.3 : 0.25;
+            text << "box block" << b << " white " << x << " 0.8 " << z << " " << x + side << " 1.1 "
+                 << z + side << "\n";
         }
         std::istringstream in(text.str());
         return parse_scene(in, "boxes.scene");
     };
-    for (const int boxes : {1, 4}) {
+    for (const int boxes : {1, 4, 20}) {
         CAPTURE(boxes);
         const Scene scene = scene_with(boxes);
         REQUIRE(scene.settings.shadows == ShadowSetting::Auto);  // the default
         const Octree octree = build_octree(scene);
         SolverOptions o = quick_options(scene, 1);
-        REQUIRE(o.exact_shadow_surfaces == 16);
+        REQUIRE(o.exact_shadow_casters == 16);
         REQUIRE(o.receiver.shadows.method == ShadowMethod::Exact);
         const Solution automatic = solve(scene, octree, o);
         const int floor = scene.find_surface("floor");
-        if (boxes == 1) {
-            CHECK(automatic.stats.paper_transfers == 0);  // 6 surfaces between: exact
+        if (boxes <= 4) {
+            CHECK(automatic.stats.paper_transfers == 0);  // up to 24 surfaces, 4 solids: exact
         } else {
-            CHECK(automatic.stats.paper_transfers >= 1);  // 24: the floor takes the fractions
+            CHECK(automatic.stats.paper_transfers >= 1);  // 20 solids: the floor's fractions
             CHECK(automatic.stats.paper_transfers < automatic.stats.transfers);
         }
         CHECK(automatic.stats.transfers == automatic.stats.per_shot[0].receivers);
         // The floor's power under auto against exact visibility everywhere: within 2 %.
-        o.exact_shadow_surfaces = 0;
+        o.exact_shadow_casters = 0;
         const Solution exact = solve(scene, octree, o);
         CHECK(exact.stats.paper_transfers == 0);
         // (The floor's area factor is constant: its mean B stands for its power.)

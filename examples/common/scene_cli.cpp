@@ -465,8 +465,8 @@ void print_summary(std::ostream& os, const SceneRun& run, const SolveStats& st) 
        << st.analytic_evals << ", shadow rays " << st.rays << "\n";
     if (st.paper_transfers > 0)
         os << "shadows auto: the paper's fractions for " << st.paper_transfers << " of "
-           << st.transfers << " transfers (more than " << run.options.exact_shadow_surfaces
-           << " occluding surfaces between the pair), exact visibility for the rest\n";
+           << st.transfers << " transfers (more than " << run.options.exact_shadow_casters
+           << " shadow casters between the pair), exact visibility for the rest\n";
     if (st.weak_transfers > 0)
         os << "weak transfers: " << st.weak_transfers << " of " << st.transfers
            << " (every root sample below " << cell_g(run.options.receiver.weak_transfer, 3)

@@ -54,7 +54,7 @@ std::vector<QuadratureRow> quadrature_study(const TransferSetup& setup, double s
                                             const std::vector<double>& tolerances) {
     const SurfacePoint p = setup.receiver.evaluate(s, t);
     const double exact = point_polygon_form_factor(p.position, p.normal, setup.shooter_polygon());
-    const Shooter shooter{&setup.shooter, SplineField::constant(4, 0, {1, 1, 1})};
+    const Shooter shooter{&setup.shooter, SplineField::constant(4, 0, {1, 1, 1}), nullptr};
     std::vector<QuadratureRow> rows;
     for (double tol : tolerances) {
         // The integrand of (21) over the shooter's (u, v): F(p, x) A_h, with B_h = rho = 1.

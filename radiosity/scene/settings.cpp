@@ -123,7 +123,8 @@ std::vector<OptionSpec> make_option_table() {
         choice_option("shadows", &S::shadows, {"exact", "paper", "none", "auto"},
                       "visibility inside (21) (beyond the paper), the paper's fractions (28) "
                       "with masking, no shadows, or auto: exact, but the paper's for a pair "
-                      "with more than 16 occluding surfaces between its two"),
+                      "with more than 16 shadow casters between its two (convex solids, and the "
+                      "surfaces of other occluders)"),
         real_option("tolerance", &S::tolerance, 0, 1, true, true, "x",
                     "accuracy relative to the scene's radiosity scale (emitted power / total "
                     "area): every transfer's absolute tolerance"),

@@ -19,8 +19,8 @@ enum class ShadowSetting {
     Exact,  // "exact": visibility inside (21), the visible part of the shooter (beyond the paper)
     Paper,  // "paper": fractions (28) at the fulcrums, shadow subdivision and masking
     None,   // "none": no shadows
-    Auto    // "auto": exact, except for a pair with many occluding surfaces between it, which
-            //   takes the paper's (SolverOptions::exact_shadow_surfaces)
+    Auto    // "auto": exact, except for a pair with many shadow casters between it, which
+            //   takes the paper's (SolverOptions::exact_shadow_casters)
 };
 /// How the increment is continued outside [0,1]^2 (section 6, "Extrapolation").
 enum class ExtrapolationSetting {

@@ -209,7 +209,7 @@ SolverOptions solver_options(const SolverSettings& s) {
     // the shooter's image, the paper's fractions (28) per fulcrum with a bounded count of rays;
     // the Cornell box's pairs have at most 10 occluding surfaces between them and keep exact
     // visibility, a floor under 500 boxes takes the fractions (docs/method.md, "Shadows auto").
-    if (s.shadows == ShadowSetting::Auto) o.exact_shadow_surfaces = 16;
+    if (s.shadows == ShadowSetting::Auto) o.exact_shadow_casters = 16;
     o.max_shots = s.max_shots;
     o.convergence = s.convergence;
     o.self_transfer = s.self_transfer;
@@ -688,8 +688,8 @@ std::vector<ProgressiveSolver::Received> ProgressiveSolver::transfer_to(
                              [&rho](double s, double t) { return rho.value(s, t); }),
             hidden_[i].any() ? &hidden_[i] : nullptr};
         const OcclusionContext& occlusion = contexts[size_t(k)];
-        if (options_.exact_shadow_surfaces > 0 && options.shadows.method == ShadowMethod::Exact &&
-            int(occlusion.surface_boxes.size()) > options_.exact_shadow_surfaces) {
+        if (options_.exact_shadow_casters > 0 && options.shadows.method == ShadowMethod::Exact &&
+            shadow_casters(occlusion) > options_.exact_shadow_casters) {
             options.shadows.method = ShadowMethod::Fractions;
             results[k].paper = true;
         }

@@ -64,9 +64,10 @@ struct SolverOptions {
                                     //   is viewed non-negative by the scene's setting)
     bool irradiance_fields = true;  // beyond the paper: a surface with a textured reflectance
                                     //   stores H (B = E + rho H, radiosity_view.h)
-    int exact_shadow_surfaces = 0;  // > 0 with exact shadows (`set shadows auto`): a pair whose
-                                    //   occluder candidates belong to more surfaces than this
-                                    //   takes the paper's fractions instead
+    int exact_shadow_casters = 0;   // > 0 with exact shadows (`set shadows auto`): a pair with
+                                    //   more shadow casters than this (convex solids and the
+                                    //   surfaces of other occluders: shadow_casters) takes the
+                                    //   paper's fractions instead
     bool ambient = true;            // beyond the paper: at the end, the power still unshot is
                                     //   sent on through the measured coupling of the surfaces
                                     //   (the fraction of each shooter's power each receiver got,

@@ -52,6 +52,11 @@ OcclusionContext pair_context(const Octree& octree, int shooter_surface, int rec
 /// Fills context.surface_boxes (with surface_box_counts and segment_boxes) from its candidates.
 void group_surface_boxes(OcclusionContext& context);
 
+/// What casts the pair's shadows as exact visibility projects them: its whole convex solids
+/// (one silhouette each: attach_solids) and the surfaces of its loose polygons; without solids,
+/// the surfaces of its candidates (surface_boxes).
+int shadow_casters(const OcclusionContext& context);
+
 /// A box of polygons grown by 1e-9 of its coordinates' magnitude and size: more than a
 /// polygon's hits reach beyond its vertices' box (its edge slack, 1e-10 of its diameter).
 Box3 grown_for_segments(const Box3& box);

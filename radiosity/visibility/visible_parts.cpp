@@ -326,18 +326,41 @@ BlockedView blocked_view(const ShooterPlane& plane, Vec3 p, Vec3 n_p,
     const double h_p = dot(plane.normal, p - plane.origin);  // height of p above the plane
     if (!context || context->candidates.empty() || h_p <= 0) return view;
     const std::vector<Polygon>& polys = context->octree->polygons();
-    // Many occluders for the pair (a big scene): only those that meet the pyramid from p to the
-    // shooter count for p, found with the octree; still too many: rays instead of projection.
-    std::vector<int> near_p;
+    // What casts a shadow at p: whole convex solids (one silhouette each) and loose polygons.
+    // DESIGN: exact_limit counts these casters, not polygons: a box standing in the way is one
+    // shadow, not six (scene_scaling's room of 17 blocks, 102 faces, took one ray per
+    // quadrature node at every receiving point when the faces were counted).
+    std::vector<int> near_p, near_solids, near_loose;
     const std::vector<int>* occluders = &context->candidates;
-    if (static_cast<int>(context->candidates.size()) > exact_limit) {
+    const std::vector<int>* solid_ids = &context->solid_ids;
+    const std::vector<int>* loose = context->solids ? &context->loose : &context->candidates;
+    auto casters = [&] { return static_cast<int>(solid_ids->size() + loose->size()); };
+    if (casters() > exact_limit) {
+        // Many for the pair (a big scene): only the occluders that meet the pyramid from p to
+        // the shooter count for p, found with the octree, by their solids as the pair's are
+        // (attach_solids: a solid of the pair's stands for all its faces); still too many: rays
+        // instead of projection.
         near_p = occluders_toward(*context, plane, p);
-        if (static_cast<int>(near_p.size()) > exact_limit) {
+        for (int id : near_p) {
+            const int s = context->solids && id < int(context->solids->solid_of.size())
+                              ? context->solids->solid_of[size_t(id)]
+                              : -1;
+            if (s >= 0 && std::find(context->solid_ids.begin(), context->solid_ids.end(), s) !=
+                              context->solid_ids.end()) {
+                if (std::find(near_solids.begin(), near_solids.end(), s) == near_solids.end())
+                    near_solids.push_back(s);
+            } else {
+                near_loose.push_back(id);
+            }
+        }
+        occluders = &near_p;
+        solid_ids = &near_solids;
+        loose = &near_loose;
+        if (casters() > exact_limit) {
             view.use_rays = true;
             view.occluders = std::move(near_p);
             return view;
         }
-        occluders = &near_p;
     }
     auto add_shadow = [&view](ConvexPolygon shadow) {
         if (!shadow.empty()) view.shadows.push_back(std::move(shadow));
@@ -345,22 +368,18 @@ BlockedView blocked_view(const ShooterPlane& plane, Vec3 p, Vec3 n_p,
     auto add_face = [&](int id) {
         add_shadow(project_occluder(plane, p, h_p, polys[size_t(id)].vertices()));
     };
-    if (context->solids && occluders == &context->candidates) {
-        // Each convex solid by its silhouette (convex_solids.h), or where its rule does not
-        // hold at p, by those of its faces that are candidates.
-        for (int s : context->solid_ids) {
-            const ConvexSolid& solid = context->solids->solids[size_t(s)];
-            if (std::optional<ConvexPolygon> shadow = solid_shadow(plane, p, h_p, solid)) {
-                add_shadow(std::move(*shadow));
-                continue;
-            }
-            for (int id : solid.polygons)
-                if (std::binary_search(occluders->begin(), occluders->end(), id)) add_face(id);
+    // Each convex solid by its silhouette (convex_solids.h), or where its rule does not hold at
+    // p, by those of its faces that are occluders.
+    for (int s : *solid_ids) {
+        const ConvexSolid& solid = context->solids->solids[size_t(s)];
+        if (std::optional<ConvexPolygon> shadow = solid_shadow(plane, p, h_p, solid)) {
+            add_shadow(std::move(*shadow));
+            continue;
         }
-        for (int id : context->loose) add_face(id);
-    } else {
-        for (int id : *occluders) add_face(id);
+        for (int id : solid.polygons)
+            if (std::binary_search(occluders->begin(), occluders->end(), id)) add_face(id);
     }
+    for (int id : *loose) add_face(id);
     merge_shadows(view.shadows);
     // DESIGN: vertices within 1e-10 of the shooter's size of the line through their neighbours
     // are removed (changing a shadow's area by about 1e-10 of the shooter's). Clipping and the
