@@ -129,6 +129,28 @@ Rgb mean_sent(const GatherHit* kept, int rays, const std::vector<PolynomialPatch
     return (1.0 / rays) * sum;
 }
 
+/// What each surface sends at the gather's level: the field through its samples' rho H
+/// (`reflected`, from `first`), as polynomial pieces in sent[j], where any sample is non-zero
+/// (sends[j]).
+void fields_sent(const std::vector<Rgb>& reflected, const std::vector<int>& first,
+                 const std::vector<int>& order, int level, std::vector<PolynomialPatches>& sent,
+                 std::vector<bool>& sends) {
+    for (size_t j = 0; j < sends.size(); ++j) {
+        sends[j] = false;
+        for (int item = first[j]; item < first[j + 1]; ++item)
+            sends[j] = sends[j] || max_abs(reflected[size_t(item)]) > 0;
+        if (sends[j])
+            sent[j] = PolynomialPatches(
+                l2_projection_of_samples(order[j], level, order[j], &reflected[size_t(first[j])]));
+    }
+}
+
+/// The memory of `samples` gather points that keep `rays` hits each, `rgb` colours, a weight
+/// and a flag.
+double gather_points_bytes(double samples, int rays, int rgb) {
+    return samples * (double(rays) * sizeof(GatherHit) + rgb * sizeof(Rgb) + sizeof(double) + 1);
+}
+
 }  // namespace
 
 int gather_rays_per_point(int rays, double samples) {
@@ -140,7 +162,7 @@ double ambient_gather_bytes(const std::vector<int>& order, int level, int rays) 
     double samples = 0;
     for (int m : order) samples += double(sample_side(m, level)) * sample_side(m, level);
     rays = gather_rays_per_point(rays, samples);
-    return samples * (double(rays) * sizeof(GatherHit) + 6 * sizeof(Rgb) + sizeof(double) + 1);
+    return gather_points_bytes(samples, rays, 6);
 }
 
 double final_gather_bytes(const Scene& scene, const std::vector<int>& order, int level, int rays) {
@@ -152,7 +174,7 @@ double final_gather_bytes(const Scene& scene, const std::vector<int>& order, int
     }
     rays =
         gather_rays_per_point(std::max(ambient_min_rays, rays / final_gather_ray_share), samples);
-    return samples * (double(rays) * sizeof(GatherHit) + 4 * sizeof(Rgb) + sizeof(double) + 1);
+    return gather_points_bytes(samples, rays, 4);
 }
 
 int final_gather_level(const Surface& surface, double diagonal, int level) {
@@ -392,14 +414,7 @@ AmbientGather gather_ambient(const Scene& scene, const Octree& octree,
     std::vector<PolynomialPatches> bounce(n);
     std::vector<bool> has_bounce(n, false);
     while (out.iterations < ambient_max_iterations && power > 0) {
-        for (int i = 0; i < n; ++i) {
-            has_bounce[i] = false;
-            for (int item = first[i]; item < first[i + 1]; ++item)
-                has_bounce[i] = has_bounce[i] || max_abs(reflected[item]) > 0;
-            if (has_bounce[i])
-                bounce[i] = PolynomialPatches(l2_projection_of_samples(
-                    sources.order[i], level, sources.order[i], &reflected[first[i]]));
-        }
+        fields_sent(reflected, first, sources.order, level, bounce, has_bounce);
         parallel_for(n_samples, [&](int item) {
             if (!gathers[item]) return;
             H[item] = first_bounce[item] +
@@ -414,17 +429,21 @@ AmbientGather gather_ambient(const Scene& scene, const Octree& octree,
 
     out.power = power;
     out.added.resize(n);
+    // Surface i's field to add at the gather's level: H for an irradiance field, else rho H.
     std::vector<Rgb> samples(n_samples);
-    for (int i = 0; i < n; ++i) {
+    auto added_field = [&](int i) {
         bool any = false;
         for (int item = first[i]; item < first[i + 1]; ++item) {
-            out.rays += gathers[item] ? rays : 0;
             samples[item] = sources.irradiance[i] ? H[item] : reflected[item];
             any = any || max_abs(samples[item]) > 0;
         }
-        if (any)
-            out.added[i] = l2_projection_of_samples(sources.order[i], level, sources.order[i],
-                                                    &samples[first[i]]);
+        return any ? l2_projection_of_samples(sources.order[i], level, sources.order[i],
+                                              &samples[first[i]])
+                   : SplineField();
+    };
+    for (int i = 0; i < n; ++i) {
+        for (int item = first[i]; item < first[i + 1]; ++item) out.rays += gathers[item] ? rays : 0;
+        out.added[i] = added_field(i);
     }
     if (!(final_threshold > 0)) return out;
     const FirstGather g{level, scale, first, reflected, first_lights, has_unshot, emits};
@@ -434,22 +453,18 @@ AmbientGather gather_ambient(const Scene& scene, const Octree& octree,
     // What every surface sends after the converged gather: R_j, its level-`level` field.
     std::vector<PolynomialPatches> sent(n);
     std::vector<bool> sends(n, false);
-    for (int j = 0; j < n; ++j) {
-        for (int item = first[j]; item < first[j + 1]; ++item)
-            sends[j] = sends[j] || max_abs(reflected[item]) > 0;
-        if (sends[j])
-            sent[j] = PolynomialPatches(l2_projection_of_samples(
-                sources.order[j], level, sources.order[j], &reflected[first[j]]));
-    }
+    fields_sent(reflected, first, sources.order, level, sent, sends);
     FinalGather refined = final_pass(scene, sources, points, sent, sends);
+    // A refined surface sends its final pass's field instead.
+    auto send_refined = [&](int j) {
+        sends[j] = !refined.sent[j].empty();
+        if (sends[j]) sent[j] = PolynomialPatches(refined.sent[j]);
+    };
     // The final gather once more through the same hits, from what the refined surfaces send
     // after the first pass: a small refined surface beside a large one sees the large one's
     // ambient light at the large one's final level, not spread over its level-`level` cells.
     for (int j = 0; j < n; ++j)
-        if (points.level[j] >= 0) {
-            sends[j] = !refined.sent[j].empty();
-            if (sends[j]) sent[j] = PolynomialPatches(refined.sent[j]);
-        }
+        if (points.level[j] >= 0) send_refined(j);
     refined = final_pass(scene, sources, points, sent, sends);
     out.rays += refined.rays;
     for (int i = 0; i < n; ++i) {
@@ -459,8 +474,7 @@ AmbientGather gather_ambient(const Scene& scene, const Octree& octree,
             out.power -= weight[item] * (reflected[item].r + reflected[item].g + reflected[item].b);
         out.power += refined.power[size_t(i)];
         out.added[i] = refined.added[size_t(i)];
-        sends[i] = !refined.sent[i].empty();
-        if (sends[i]) sent[i] = PolynomialPatches(refined.sent[i]);
+        send_refined(i);
     }
     // The last bounce (beyond the final gather): the surfaces it did not refine take one more
     // step of the iteration through their kept hits, from what every surface sends now, the
@@ -474,18 +488,13 @@ AmbientGather gather_ambient(const Scene& scene, const Octree& octree,
     });
     for (int i = 0; i < n; ++i) {
         if (points.level[i] >= 0) continue;
-        bool any = false;
         for (int item = first[i]; item < first[i + 1]; ++item) {
             const Rgb old_reflected = reflected[item];
             reflected[item] = rho[item] * H[item];
             out.power += weight[item] * (reflected[item].r + reflected[item].g + reflected[item].b -
                                          old_reflected.r - old_reflected.g - old_reflected.b);
-            samples[item] = sources.irradiance[i] ? H[item] : reflected[item];
-            any = any || max_abs(samples[item]) > 0;
         }
-        out.added[i] = any ? l2_projection_of_samples(sources.order[i], level, sources.order[i],
-                                                      &samples[first[i]])
-                           : SplineField();
+        out.added[i] = added_field(i);
     }
     return out;
 }

@@ -340,18 +340,19 @@ BlockedView blocked_view(const ShooterPlane& plane, Vec3 p, Vec3 n_p,
         // the shooter count for p, found with the octree, by their solids as the pair's are
         // (attach_solids: a solid of the pair's stands for all its faces); still too many: rays
         // instead of projection.
+        // (A candidate that attach_solids did not leave loose belongs to one of solid_ids. The
+        // grouping stops once the casters pass the limit: rays then, whatever the rest.)
         near_p = occluders_toward(*context, plane, p);
         for (int id : near_p) {
-            const int s = context->solids && id < int(context->solids->solid_of.size())
+            const int s = context->solids && !std::binary_search(context->loose.begin(),
+                                                                 context->loose.end(), id)
                               ? context->solids->solid_of[size_t(id)]
                               : -1;
-            if (s >= 0 && std::find(context->solid_ids.begin(), context->solid_ids.end(), s) !=
-                              context->solid_ids.end()) {
-                if (std::find(near_solids.begin(), near_solids.end(), s) == near_solids.end())
-                    near_solids.push_back(s);
-            } else {
+            if (s < 0)
                 near_loose.push_back(id);
-            }
+            else if (std::find(near_solids.begin(), near_solids.end(), s) == near_solids.end())
+                near_solids.push_back(s);
+            if (static_cast<int>(near_solids.size() + near_loose.size()) > exact_limit) break;
         }
         occluders = &near_p;
         solid_ids = &near_solids;
