@@ -385,6 +385,7 @@ Octree::Octree(std::vector<Polygon> polygons, Options options)
     root_ = build(root_cube_, std::move(ids), 0, numbering);
     has_root_ = true;
     make_records(numbering);
+    prefetch_ = double(records_.size()) * sizeof(RayRecord) > options_.prefetch_bytes;
 }
 
 // The ray records in the order of `numbering` (a polygon no leaf lists, which the node test
@@ -468,7 +469,18 @@ Octree::Node Octree::build(const Box3& cube, std::vector<int> ids, int depth,
     return leaf;
 }
 
+// Asks the memory for the three cache lines of every record a leaf lists (prefetch_).
+void Octree::prefetch_records(const Node& leaf) const {
+    for (int r = leaf.first, end = leaf.first + leaf.count(); r < end; ++r) {
+        const char* rec = reinterpret_cast<const char*>(&records_[leaf_records_[r]]);
+        __builtin_prefetch(rec);
+        __builtin_prefetch(rec + 64);
+        __builtin_prefetch(rec + 128);
+    }
+}
+
 bool Octree::test_leaf(const Node& node, Query& q) const {
+    if (prefetch_) prefetch_records(node);
     for (int r = node.first, end = node.first + node.count(); r < end; ++r) {
         const RayRecord& p = records_[leaf_records_[r]];
         const int id = p.polygon;
@@ -511,14 +523,32 @@ bool Octree::traverse(const Node& node, Query& q) const {
     if (node.is_leaf()) return test_leaf(node, q);
     const Block& block = blocks_[node.first];
     const ChildHits hits = child_hits(block, node.child_mask(), q);
+    // DESIGN (prefetch_, octree.h): every child met is asked for at once, so that their misses
+    // overlap, and below, the records of the child visited next while this one is walked.
+    if (prefetch_)
+        for (unsigned m = hits.meets; m != 0; m &= m - 1) {
+            const Node& c = block.child[lowest_bit.of[m]];
+            if (c.is_leaf())
+                __builtin_prefetch(&leaf_records_[c.first]);
+            else {
+                __builtin_prefetch(&blocks_[c.first]);
+                __builtin_prefetch(reinterpret_cast<const char*>(&blocks_[c.first]) + 64);
+            }
+        }
     if (q.any) {
         // Any hit: t_max stays put, so every child met is visited unless a hit ends the query,
         // and the answer does not depend on the order. The direction's signs give one no ray
         // contradicts: with bit k of flip set where dir[k] < 0, child j ^ flip for j = 0..7 (a
         // ray crosses from child a into child b only where b's bits differ from a's towards the
         // signs). No sort.
-        for (unsigned order = flip_bits(hits.meets, q.flip); order != 0; order &= order - 1)
+        for (unsigned order = flip_bits(hits.meets, q.flip); order != 0; order &= order - 1) {
+            const unsigned rest = order & (order - 1);
+            if (prefetch_ && rest) {
+                const Node& next = block.child[lowest_bit.of[rest] ^ q.flip];
+                if (next.is_leaf()) prefetch_records(next);
+            }
             if (traverse(block.child[lowest_bit.of[order] ^ q.flip], q)) return true;
+        }
         return false;
     }
     // Closest hit: by the t at which the ray enters the children's grown cubes (disjoint but for
@@ -528,6 +558,8 @@ bool Octree::traverse(const Node& node, Query& q) const {
     std::array<int, 8> order;
     for (int k = 0, n = hits.sorted(q.flip, order); k < n; ++k) {
         if (hits.entry[order[k]] > q.ray.t_max) break;
+        if (prefetch_ && k + 1 < n && block.child[order[k + 1]].is_leaf())
+            prefetch_records(block.child[order[k + 1]]);
         traverse(block.child[order[k]], q);
     }
     return false;

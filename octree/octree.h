@@ -25,6 +25,8 @@
 // one array of "ray records": what the ray-polygon test reads of a polygon (its plane, bounding
 // planes, slack, surface and index) in three cache lines, numbered in the order the leaves first
 // list them, so a leaf's records lie close together. Queries keep their state on the stack.
+// When the records outgrow the cache (OctreeOptions::prefetch_bytes), queries ask the memory for
+// the children and records they will read next before reading them (prefetch_).
 #pragma once
 
 #include <algorithm>
@@ -108,6 +110,9 @@ struct RayFilter {
 struct OctreeOptions {
     int max_depth = 10;             // depth of the deepest allowed node (the root has depth 0)
     int max_polygons_per_leaf = 8;  // a node listing more is split (below max_depth, if it pays)
+    // Queries prefetch (Octree::prefetch_) when the ray records take more than this many bytes
+    // (about 21,800 polygons); 0: always. Answers and RayStats do not depend on it.
+    double prefetch_bytes = 4.0 * 1024 * 1024;
 };
 
 /// The paper's pointer octree over a set of polygons (its pointers are indices: see the file
@@ -226,6 +231,7 @@ private:
     Box3 grown(const Box3& cube) const;
     bool traverse(const Node& node, Query& query) const;
     bool test_leaf(const Node& node, Query& query) const;
+    void prefetch_records(const Node& leaf) const;
     ChildHits child_hits(const Block& block, unsigned mask, const Query& query) const;
     template <class NodeTest>
     void collect(const Node& node, const Box3& cube, NodeTest& test, std::vector<int>& out) const;
@@ -242,6 +248,13 @@ private:
     std::vector<RayRecord> records_;   // in the order the leaves first list them
     std::vector<int> record_polygon_;  // records_[r].polygon, compact (for collect)
     std::vector<Plane> extra_planes_;  // bounding planes of polygons with more than four
+    // DESIGN: past Options::prefetch_bytes of records, random rays wait on memory at every node and
+    // record (octree_stats on 200,000 quads, 37 MiB of records: `perf` put a third of the
+    // time on the load of a record's first line and a fifth on the leaf's list), so queries
+    // ask for the children they will visit and for the records of a leaf ahead of reading
+    // them. Below it the tree stays in the cache and the prefetches only cost (the room,
+    // 2,558 polygons: any-hit rays 15 % slower). Measured in docs/method.md, "Octree and rays".
+    bool prefetch_ = false;
     int node_count_ = 0;
     int leaf_count_ = 0;
     int depth_ = 0;

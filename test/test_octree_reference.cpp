@@ -312,9 +312,11 @@ TEST_CASE("octree: the flat layout visits and tests as the pointer octree did", 
     const unsigned seed = 777;
     std::mt19937 rng(seed);
     const std::vector<Polygon> polygons = scene(rng, 900);
+    // The last two prefetch (prefetch_bytes 0), as trees of large scenes do: the same walk.
     for (OctreeOptions options :
-         {OctreeOptions{}, OctreeOptions{6, 4}, OctreeOptions{0, 8}, OctreeOptions{12, 1}}) {
-        CAPTURE(seed, options.max_depth, options.max_polygons_per_leaf);
+         {OctreeOptions{}, OctreeOptions{6, 4}, OctreeOptions{0, 8}, OctreeOptions{12, 1},
+          OctreeOptions{10, 8, 0}, OctreeOptions{12, 1, 0}}) {
+        CAPTURE(seed, options.max_depth, options.max_polygons_per_leaf, options.prefetch_bytes);
         const Octree octree(polygons, options);
         const ReferenceOctree reference(polygons, options);
         std::vector<Box3> cubes;  // every node's grown cube
