@@ -8,17 +8,21 @@
 #include <array>
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <cstdint>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "math/check.h"
 #include "radiosity/scene/scene_io.h"
 #include "radiosity/scene/scene_octree.h"
 #include "radiosity/solver/solver.h"
+#include "radiosity/transfer/form_factor.h"
 #include "radiosity/transfer/sample_values.h"
 #include "radiosity/transfer/transfer.h"
 #include "radiosity/visibility/hidden_regions.h"
+#include "radiosity/visibility/occlusion.h"
 #include "radiosity/visibility/visible_parts.h"
 #include "test/report.h"
 #include "test/solution_text.h"
@@ -884,4 +888,91 @@ TEST_CASE("shadows auto: exact between few shadow casters, the paper's between m
         const double a = a_rgb.r + a_rgb.g + a_rgb.b, e = e_rgb.r + e_rgb.g + e_rgb.b;
         CHECK(a == Approx(e).epsilon(0.02));
     }
+}
+
+namespace {
+
+/// A room of 10 x 20 x 10 lit by 32 small ceiling lamps, with a shelf (a box of 4 x 4 x 0.3)
+/// standing out of its wall x = -5 at heights 3.7 to 4: the floor, a dim shooter next to the
+/// lamps, lights the wall up to the shelf's underside and not above it.
+Scene shelf_room() {
+    std::ostringstream text;
+    text << "material wall reflectance 0.5 0.5 0.5\n"
+            "material shelf reflectance 0.4 0.35 0.2\n"
+            "material lamp reflectance 0 0 0 emission 2000 2000 2000\n"
+            "box room wall -5 0 0 5 20 10 inward\n"
+            "box shelf shelf -5 16 3.7 -1 20 4\n";
+    for (int i = 0; i < 4; ++i)
+        for (int j = 0; j < 8; ++j)
+            text << "rectangle lamp" << i * 8 + j << " lamp " << -3.95 + 2.5 * i << ' '
+                 << 1.05 + 2.5 * j << " 9.98  0 0.4 0  0.4 0 0\n";
+    return scene_from(text.str());
+}
+
+/// The increment of the floor's first shot at `p` on the wall, and a Monte Carlo estimate of the
+/// same: rho times the integral over the floor of its unshot field (before the shot) times the
+/// kernel (3), with octree visibility (n_samples stratified in u).
+std::pair<double, double> floor_shot_at(const Scene& scene, const SolverOptions& options, Vec3 p,
+                                        int n_samples) {
+    const Octree octree = build_octree(scene);
+    const int floor = scene.find_surface("room.zmin"), wall = scene.find_surface("room.xmin");
+    const Surface& receiver = scene.surfaces[size_t(wall)].surface;
+    // The wall's (u, v) of p: it is a rectangle, so the inverse of its bilinear map is linear.
+    const Vec3 o = receiver.evaluate(0, 0).position, eu = receiver.evaluate(1, 0).position - o,
+               ev = receiver.evaluate(0, 1).position - o;
+    const double u = dot(p - o, eu) / dot(eu, eu), v = dot(p - o, ev) / dot(ev, ev);
+    REQUIRE(length(receiver.evaluate(u, v).position - p) < 1e-9);
+    ProgressiveSolver solver(scene, octree, options);
+    for (int shot = 0; shot < 40; ++shot) {
+        const std::vector<SplineField> unshot = solver.solution().unshot;
+        const Rgb before = solver.solution().radiosity[size_t(wall)].evaluate(u, v);
+        const ShotStats stats = solver.shoot();
+        if (stats.shooter != floor) continue;
+        const Rgb increment = solver.solution().radiosity[size_t(wall)].evaluate(u, v) - before;
+        const SurfacePoint at = receiver.evaluate(u, v);
+        const Surface& shooter = scene.surfaces[size_t(floor)].surface;
+        RayFilter filter;
+        filter.skip_surface_a = floor;
+        filter.skip_surface_b = wall;
+        Rgb sum;
+        for (int k = 0; k < n_samples; ++k) {
+            const double s = (k + uniform01(11, std::uint64_t(k))) / n_samples,
+                         t = uniform01(12, std::uint64_t(k));
+            const SurfacePoint q = shooter.evaluate(s, t);
+            const double F = form_factor_kernel(at.position, at.normal, q.position, q.normal);
+            if (F == 0) continue;
+            if (octree.any_hit(Ray{at.position, q.position - at.position, 1e-6, 1 - 1e-6}, filter))
+                continue;
+            sum += (F * q.area_factor) * unshot[size_t(floor)].evaluate(s, t);
+        }
+        const double rho = 0.5;
+        return {luminance(increment), rho * luminance((1.0 / n_samples) * sum)};
+    }
+    FAIL("the floor did not shoot in 40 shots");
+    return {0, 0};
+}
+
+}  // namespace
+
+TEST_CASE("solver: a dim floor's light on a wall keeps its step under a shelf", "[solver]") {
+    // The floor's first shot is dim: about 6 absolute tolerances at the point 10 cm under the
+    // shelf. Wall cells 2.5 m above the floor come within half their size of it and
+    // took the contact oracle's test, the paper's two means, until the test was kept to cells
+    // within a quarter of their size (contact_test_reach): the means agreed across the step at
+    // the shelf's underside (0.13 below it, 0 above) and left a ramp of 1.25 m cells, 34 % low
+    // at this point (docs/method.md, "Known wrong answers"). The hybrid test follows the step.
+    const Scene scene = shelf_room();
+    SolverOptions options = solver_options(scene.settings);
+    const Vec3 p{-5, 18.5, 3.6};
+    const auto [got, expected] = floor_shot_at(scene, options, p, 20000);
+    test::report() << "floor's shot at 10 cm under the shelf: " << got << " against " << expected
+                   << "\n";
+    CHECK(std::fabs(got / expected - 1) < 0.1);
+    // The test tells the two tests apart: with the paper's means in every cell it fails (the
+    // floor's unshot field differs a little, since the lamps' shots do too).
+    options.receiver.oracle_test = OracleTest::Means;
+    options.receiver.contact_oracle_test = OracleTest::Means;
+    const auto [means, expected_again] = floor_shot_at(scene, options, p, 20000);
+    test::report() << "with the means everywhere: " << means << "\n";
+    CHECK(means / expected_again - 1 < -0.2);
 }

@@ -172,10 +172,10 @@ std::vector<OptionSpec> make_option_table() {
                     "polynomial through them (no edgefill, no extrapolated ring); 0: the full "
                     "pipeline for every transfer"),
         choice_option("contact_oracle", &S::contact_oracle, {"hybrid", "interpolation", "means"},
-                      "the oracle's test in receiver cells that touch a planar shooter (see "
-                      "oracle): interpolation follows B at shared edges and corners, at more "
-                      "cost; the paper's means cost least and do best on the Cornell box "
-                      "(docs/method.md)"),
+                      "the oracle's test in receiver cells that touch a planar shooter (come "
+                      "within a quarter of their size of it; see oracle): interpolation follows "
+                      "B at shared edges and corners, at more cost; the paper's means cost "
+                      "least and do best on the Cornell box (docs/method.md)"),
         choice_option("fraction_rays", &S::fraction_rays, {"kernel", "area"},
                       "paper shadows: how a fraction (28) counts its rays to a shooter patch: "
                       "each weighted by the shooter's radiosity times the kernel (3) at its end "

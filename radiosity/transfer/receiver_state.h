@@ -64,6 +64,11 @@ constexpr double oracle_share = 1;
 /// costs the Cornell box 36 % more kernel evaluations and its worst reference point 0.3 %;
 /// 4 leaves cube.mgf's penumbrae blurred (+36 % at its worst point, as the means do).
 constexpr double fit_share = 2;
+/// The contact rule splits a cell that comes within this share of its size of a planar shooter
+/// (ReceiverOptions::contact_depth, oracle.cpp) ...
+constexpr double contact_split_reach = 0.5;
+/// ... and asks the contact oracle's test (contact_oracle_test) of a cell within this share.
+constexpr double contact_test_reach = 0.25;
 
 /// How the increment is continued outside [0,1]^2 (section 6, "Extrapolation").
 enum class Extrapolation {
