@@ -945,8 +945,9 @@ std::pair<double, double> floor_shot_at(const Scene& scene, const SolverOptions&
                 continue;
             sum += (F * q.area_factor) * unshot[size_t(floor)].evaluate(s, t);
         }
-        const double rho = 0.5;
-        return {luminance(increment), rho * luminance((1.0 / n_samples) * sum)};
+        const Rgb rho = scene.material_of(wall).reflectance.value(u, v);
+        const Rgb reflected = (1.0 / n_samples) * Rgb{rho.r * sum.r, rho.g * sum.g, rho.b * sum.b};
+        return {luminance(increment), luminance(reflected)};
     }
     FAIL("the floor did not shoot in 40 shots");
     return {0, 0};
