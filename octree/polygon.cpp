@@ -100,6 +100,20 @@ Polygon::Polygon(std::vector<Vec3> vertices, std::vector<Vec2> uv, int surface)
     axis_v_ = cross(n_p, axis_u_);
     local_.reserve(n);
     for (Vec3 v : vertices_) local_.push_back(to_local(v));
+    // DESIGN: a quad whose twist q0 - q1 + q2 - q3 vanishes to rounding (the rule of
+    // make_shooter_plane) is a parallelogram: its bilinear map is affine, and uv_at inverts it
+    // by two dot products in space instead of inverse_bilinear's closed form and Newton steps
+    // (a fifth of a closest-hit query on the room, whose facets are rectangles).
+    if (n == 4) {
+        const Vec2 e = local_[1] - local_[0], f = local_[3] - local_[0];
+        const Vec2 g = local_[0] - local_[1] + local_[2] - local_[3];
+        const double det = cross(e, f);
+        if (det != 0 && std::sqrt(dot(g, g)) <= 1e-14 * std::sqrt(std::fabs(det))) {
+            parallelogram_ = true;
+            inverse_s_ = (f.y / det) * axis_u_ - (f.x / det) * axis_v_;
+            inverse_t_ = (e.x / det) * axis_v_ - (e.y / det) * axis_u_;
+        }
+    }
 }
 
 bool Polygon::contains(Vec3 p) const {
@@ -147,6 +161,10 @@ Vec2 Polygon::to_local(Vec3 p) const {
 }
 
 Vec2 Polygon::uv_at(Vec3 p) const {
+    if (parallelogram_) {
+        const Vec3 d = p - vertices_[0];
+        return uv_bilinear(dot(d, inverse_s_), dot(d, inverse_t_));
+    }
     Vec2 q = to_local(p);
     if (n_vertices() == 3) {
         // Barycentric coordinates from signed areas of the sub-triangles opposite each vertex.
@@ -162,7 +180,10 @@ Vec2 Polygon::uv_at(Vec3 p) const {
 
 Vec2 Polygon::uv_quad(Vec2 q) const {
     const Vec2 st = inverse_bilinear(local_[0], local_[1], local_[2], local_[3], q);
-    const double s = st.x, t = st.y;
+    return uv_bilinear(st.x, st.y);
+}
+
+Vec2 Polygon::uv_bilinear(double s, double t) const {
     return (1 - s) * (1 - t) * uv_[0] + s * (1 - t) * uv_[1] + s * t * uv_[2] +
            (1 - s) * t * uv_[3];
 }

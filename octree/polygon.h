@@ -169,6 +169,7 @@ public:
 private:
     Vec2 to_local(Vec3 p) const;
     Vec2 uv_quad(Vec2 q) const;
+    Vec2 uv_bilinear(double s, double t) const;  // the vertices' (u, v) blended at (s, t)
     Vec2 uv_mean_value(Vec2 q) const;
 
     std::vector<Vec3> vertices_;
@@ -185,6 +186,9 @@ private:
     // An orthonormal frame of the plane (origin at vertex 0) and the vertices in it, for uv_at.
     Vec3 axis_u_, axis_v_;
     std::vector<Vec2> local_;
+    // A parallelogram's inverse map: (s, t) = (dot(p - vertex 0, inverse_s_), dot(.., inverse_t_)).
+    bool parallelogram_ = false;
+    Vec3 inverse_s_, inverse_t_;
 };
 
 /// Prints the surface id and the vertices.

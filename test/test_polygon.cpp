@@ -392,3 +392,43 @@ TEST_CASE("polygon: uv_at inverts the bilinear map of a quadrilateral", "[polygo
     CHECK(w.x == Approx(0.625).margin(1e-15));
     CHECK(w.y == Approx(0.5).margin(1e-15));
 }
+
+TEST_CASE("polygon: uv_at on parallelograms, by their affine inverse, agrees with the bilinear one",
+          "[polygon]") {
+    // Parallelograms (the twist q0 - q1 + q2 - q3 zero to rounding) take the affine inverse in
+    // space; quads twisted by as little as 1e-9 of their size take inverse_bilinear. Both must
+    // give the bilinear blend of the corners' (u, v) at the point's (s, t), also for points off
+    // the plane (projected along the normal) and slightly outside (extrapolated).
+    const unsigned seed = 4321;
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> u01(0, 1), sym(-1, 1);
+    int n_checked = 0;
+    for (int trial = 0; trial < 300; ++trial) {
+        const Vec3 origin{100 * sym(rng), 100 * sym(rng), 100 * sym(rng)};
+        const double scale = std::pow(10.0, 3 * sym(rng));
+        Vec3 e = scale * random_unit(rng), f = scale * (0.1 + u01(rng)) * random_unit(rng);
+        const Vec3 n = normalize(cross(e, f));
+        if (!(length(cross(e, f)) > 0.05 * scale * length(f))) continue;  // nearly degenerate
+        // trial % 3 == 2: the fourth corner moved in the plane by 1e-9 of the size (a twist).
+        const Vec3 twist = trial % 3 == 2 ? 1e-9 * scale * normalize(cross(n, e)) : Vec3{0, 0, 0};
+        const std::vector<Vec3> v{origin, origin + e, origin + e + f + twist, origin + f};
+        std::vector<Vec2> uv{{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+        if (trial % 2)
+            uv = {{sym(rng), sym(rng)},
+                  {sym(rng), sym(rng)},
+                  {sym(rng), sym(rng)},
+                  {sym(rng), sym(rng)}};
+        Polygon p(v, uv, 0);
+        CAPTURE(seed, trial, p);
+        for (int r = 0; r < 20; ++r) {
+            const double s = -0.05 + 1.1 * u01(rng), t = -0.05 + 1.1 * u01(rng);
+            const Vec3 x = bilerp(v, s, t) + (r % 2 ? 0.01 * scale * sym(rng) : 0.0) * n;
+            const Vec2 w = p.uv_at(x), expected = bilerp(uv, s, t);
+            CAPTURE(s, t, x, w, expected);
+            CHECK(std::fabs(w.x - expected.x) < 1e-9);
+            CHECK(std::fabs(w.y - expected.y) < 1e-9);
+            ++n_checked;
+        }
+    }
+    CHECK(n_checked > 4000);
+}
