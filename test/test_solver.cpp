@@ -21,6 +21,7 @@
 #include "radiosity/transfer/form_factor.h"
 #include "radiosity/transfer/sample_values.h"
 #include "radiosity/transfer/transfer.h"
+#include "radiosity/visibility/convex_solids.h"
 #include "radiosity/visibility/hidden_regions.h"
 #include "radiosity/visibility/occlusion.h"
 #include "radiosity/visibility/visible_parts.h"
@@ -888,6 +889,56 @@ TEST_CASE("shadows auto: exact between few shadow casters, the paper's between m
         const double a = a_rgb.r + a_rgb.g + a_rgb.b, e = e_rgb.r + e_rgb.g + e_rgb.b;
         CHECK(a == Approx(e).epsilon(0.02));
     }
+}
+
+TEST_CASE("shadows auto: a small lamp keeps exact visibility where each point sees few casters",
+          "[solver][shadows]") {
+    // A 0.2 x 0.2 lamp 3 above a 4 x 4 floor, with 30 small boxes hovering just over the floor:
+    // the lamp-to-floor pair has 30 shadow casters (more than auto's 16 and than exact_limit),
+    // but a floor point's pyramid to the lamp is thin and meets at most a few of them, so the
+    // pair keeps exact visibility (projects_at_samples in solver.cpp); under the rule by the
+    // pair's count alone it took the fractions. The floor's power then equals exact
+    // visibility's to the bit.
+    std::ostringstream text;
+    text << "material white reflectance 0.5 0.5 0.5\n"
+            "material lamp reflectance 0 0 0 emission 500 500 500\n"
+            "rectangle floor white -2 0 -2  0 0 4  4 0 0\n"
+            "rectangle lamp lamp -0.1 3 -0.1  0.2 0 0  0 0 0.2\n";
+    for (int b = 0; b < 30; ++b) {  // (binary fractions: the boxes' corners match to the bit)
+        const double x = -1.875 + 0.625 * (b % 6), z = -1.75 + 0.75 * (b / 6);
+        text << "box block" << b << " white " << x << " 0.125 " << z << " " << x + 0.125 << " 0.25 "
+             << z + 0.125 << "\n";
+    }
+    std::istringstream in(text.str());
+    const Scene scene = parse_scene(in, "small_lamp.scene");
+    const Octree octree = build_octree(scene);
+    const int floor = scene.find_surface("floor"), lamp = scene.find_surface("lamp");
+    const ConvexSolids solids = find_convex_solids(octree.polygons());
+    REQUIRE(solids.solids.size() == 30);
+    OcclusionContext pair =
+        make_occlusion_context(octree, scene.surfaces[size_t(lamp)].surface, lamp,
+                               scene.surfaces[size_t(floor)].surface, floor, 0);
+    attach_solids(pair, solids);
+    REQUIRE(shadow_casters(pair) == 30);  // more than exact_limit: counted per point
+    // Every floor point sees few of them (the samples' rule, and a grid finer than it).
+    const ShooterPlane plane = make_shooter_plane(scene.surfaces[size_t(lamp)].surface);
+    int most = 0;
+    for (int i = 0; i <= 20; ++i)
+        for (int j = 0; j <= 20; ++j)
+            most = std::max(most, casters_toward(pair, plane, {-2 + 0.2 * i, 0, -2 + 0.2 * j}));
+    CHECK(most <= exact_limit / 2);
+    SolverOptions o = quick_options(scene, 1);
+    REQUIRE(o.exact_shadow_casters == 16);
+    const Solution automatic = solve(scene, octree, o);
+    CHECK(automatic.stats.per_shot[0].shooter == lamp);
+    CHECK(automatic.stats.paper_transfers == 0);
+    o.exact_shadow_casters = 0;  // exact everywhere
+    const Solution exact = solve(scene, octree, o);
+    const Rgb a = automatic.radiosity[size_t(floor)].integrate(),
+              e = exact.radiosity[size_t(floor)].integrate();
+    CHECK(a.r == e.r);
+    CHECK(a.g == e.g);
+    CHECK(a.b == e.b);
 }
 
 namespace {

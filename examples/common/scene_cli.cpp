@@ -17,6 +17,7 @@
 #include "radiosity/scene/scene_octree.h"
 #include "radiosity/solver/cost.h"
 #include "radiosity/solver/resolution.h"
+#include "radiosity/visibility/occlusion.h"
 
 #ifdef _OPENMP
 #include <omp.h>
@@ -466,7 +467,9 @@ void print_summary(std::ostream& os, const SceneRun& run, const SolveStats& st) 
     if (st.paper_transfers > 0)
         os << "shadows auto: the paper's fractions for " << st.paper_transfers << " of "
            << st.transfers << " transfers (more than " << run.options.exact_shadow_casters
-           << " shadow casters between the pair), exact visibility for the rest\n";
+           << " shadow casters between the pair, and more than " << exact_limit / 2
+           << " toward one of 3 x 3 points of the receiver or at most " << exact_limit
+           << " in all), exact visibility for the rest\n";
     if (st.weak_transfers > 0)
         os << "weak transfers: " << st.weak_transfers << " of " << st.transfers
            << " (every root sample below " << cell_g(run.options.receiver.weak_transfer, 3)

@@ -124,7 +124,9 @@ std::vector<OptionSpec> make_option_table() {
                       "visibility inside (21) (beyond the paper), the paper's fractions (28) "
                       "with masking, no shadows, or auto: exact, but the paper's for a pair "
                       "with more than 16 shadow casters between its two (convex solids, and the "
-                      "surfaces of other occluders)"),
+                      "surfaces of other occluders), unless it has more than 24 and at most 12 "
+                      "meet the pyramid from each of 3 x 3 points of the receiver to a planar "
+                      "shooter (a small lamp)"),
         real_option("tolerance", &S::tolerance, 0, 1, true, true, "x",
                     "accuracy relative to the scene's radiosity scale (emitted power / total "
                     "area): every transfer's absolute tolerance"),

@@ -290,6 +290,33 @@ std::optional<ConvexPolygon> solid_shadow(const ShooterPlane& plane, Vec3 p, dou
     return clip_to_shooter(plane, hull);
 }
 
+ShadowCasters casters_among(const OcclusionContext& context, const std::vector<int>& occluders,
+                            int limit) {
+    // A candidate that attach_solids did not leave loose belongs to one of the pair's solids,
+    // which stands for all its faces.
+    ShadowCasters out;
+    for (int id : occluders) {
+        const int s =
+            context.solids && !std::binary_search(context.loose.begin(), context.loose.end(), id)
+                ? context.solids->solid_of[size_t(id)]
+                : -1;
+        if (s < 0)
+            out.loose.push_back(id);
+        else if (std::find(out.solids.begin(), out.solids.end(), s) == out.solids.end())
+            out.solids.push_back(s);
+        if (out.count() > limit) break;
+    }
+    return out;
+}
+
+int casters_toward(const OcclusionContext& context, const ShooterPlane& plane, Vec3 p) {
+    // As blocked_view counts them: the pair's own when they are few, else those toward p.
+    const size_t loose = context.solids ? context.loose.size() : context.candidates.size();
+    const int pair_casters = static_cast<int>(context.solid_ids.size() + loose);
+    if (pair_casters <= exact_limit) return pair_casters;
+    return casters_among(context, occluders_toward(context, plane, p), exact_limit).count();
+}
+
 BlockedView blocked_view(const ShooterPlane& plane, Vec3 p, Vec3 n_p,
                          const OcclusionContext* context, const Plane* receiver_plane) {
     BlockedView view;
@@ -340,20 +367,11 @@ BlockedView blocked_view(const ShooterPlane& plane, Vec3 p, Vec3 n_p,
         // the shooter count for p, found with the octree, by their solids as the pair's are
         // (attach_solids: a solid of the pair's stands for all its faces); still too many: rays
         // instead of projection.
-        // (A candidate that attach_solids did not leave loose belongs to one of solid_ids. The
-        // grouping stops once the casters pass the limit: rays then, whatever the rest.)
+        // (The grouping stops once the casters pass the limit: rays then, whatever the rest.)
         near_p = occluders_toward(*context, plane, p);
-        for (int id : near_p) {
-            const int s = context->solids && !std::binary_search(context->loose.begin(),
-                                                                 context->loose.end(), id)
-                              ? context->solids->solid_of[size_t(id)]
-                              : -1;
-            if (s < 0)
-                near_loose.push_back(id);
-            else if (std::find(near_solids.begin(), near_solids.end(), s) == near_solids.end())
-                near_solids.push_back(s);
-            if (static_cast<int>(near_solids.size() + near_loose.size()) > exact_limit) break;
-        }
+        ShadowCasters near = casters_among(*context, near_p, exact_limit);
+        near_solids = std::move(near.solids);
+        near_loose = std::move(near.loose);
         occluders = &near_p;
         solid_ids = &near_solids;
         loose = &near_loose;

@@ -91,6 +91,21 @@ struct BlockedView {
 std::vector<int> occluders_toward(const OcclusionContext& context, const ShooterPlane& plane,
                                   Vec3 p, size_t limit = SIZE_MAX);
 
+/// What casts a shadow among `occluders` (polygons of the pair's candidates, increasing): the
+/// pair's convex solids they belong to (indices into context.solids, each once; attach_solids)
+/// and the loose polygons. The grouping stops once more than `limit` casters are found.
+struct ShadowCasters {
+    std::vector<int> solids, loose;
+    int count() const { return static_cast<int>(solids.size() + loose.size()); }
+};
+ShadowCasters casters_among(const OcclusionContext& context, const std::vector<int>& occluders,
+                            int limit);
+
+/// How many casters blocked_view projects at p (the pair's own when at most exact_limit, else
+/// those meeting p's pyramid to the shooter, counted up to exact_limit + 1): more than
+/// exact_limit, and p's visibility is one ray per quadrature node (BlockedView::use_rays).
+int casters_toward(const OcclusionContext& context, const ShooterPlane& plane, Vec3 p);
+
 /// The view from point p (normal n_p). `context` may be null (horizon only). When p lies on a
 /// planar receiver, `receiver_plane` (may be null) gives its plane: the horizon is then the
 /// same line for every point of the receiver, to the last bit.
