@@ -75,6 +75,15 @@ Vec3 bilerp(const std::vector<Vec3>& c, double s, double t) {
     return (1 - s) * (1 - t) * c[0] + s * (1 - t) * c[1] + s * t * c[2] + (1 - s) * t * c[3];
 }
 
+/// The (u, v) of a quad's four corners: the unit square's, or random in [-1, 1]^2.
+std::vector<Vec2> corner_uv(std::mt19937& rng, bool random) {
+    if (!random) return {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+    std::uniform_real_distribution<double> sym(-1, 1);
+    std::vector<Vec2> uv;
+    for (int k = 0; k < 4; ++k) uv.push_back({sym(rng), sym(rng)});
+    return uv;
+}
+
 std::vector<Vec2> no_uv(int n) {
     return std::vector<Vec2>(n);
 }
@@ -362,12 +371,7 @@ TEST_CASE("polygon: uv_at inverts the bilinear map of a quadrilateral", "[polygo
         double aspect = trial % 4 == 0 ? 1.0 : 0.1 + 0.9 * u01(rng);
         TestPolygon tp = random_polygon(rng, {3 * sym(rng), 3 * sym(rng), 3 * sym(rng)},
                                         std::pow(10.0, sym(rng)), aspect, 4);
-        std::vector<Vec2> uv{{0, 0}, {1, 0}, {1, 1}, {0, 1}};
-        if (trial % 2)
-            uv = {{sym(rng), sym(rng)},
-                  {sym(rng), sym(rng)},
-                  {sym(rng), sym(rng)},
-                  {sym(rng), sym(rng)}};
+        const std::vector<Vec2> uv = corner_uv(rng, trial % 2 == 1);
         Polygon p(tp.polygon.vertices(), uv, 2);
         CAPTURE(seed, trial, p);
         for (int r = 0; r < 25; ++r) {
@@ -412,12 +416,7 @@ TEST_CASE("polygon: uv_at on parallelograms, by their affine inverse, agrees wit
         // trial % 3 == 2: the fourth corner moved in the plane by 1e-9 of the size (a twist).
         const Vec3 twist = trial % 3 == 2 ? 1e-9 * scale * normalize(cross(n, e)) : Vec3{0, 0, 0};
         const std::vector<Vec3> v{origin, origin + e, origin + e + f + twist, origin + f};
-        std::vector<Vec2> uv{{0, 0}, {1, 0}, {1, 1}, {0, 1}};
-        if (trial % 2)
-            uv = {{sym(rng), sym(rng)},
-                  {sym(rng), sym(rng)},
-                  {sym(rng), sym(rng)},
-                  {sym(rng), sym(rng)}};
+        const std::vector<Vec2> uv = corner_uv(rng, trial % 2 == 1);
         Polygon p(v, uv, 0);
         CAPTURE(seed, trial, p);
         for (int r = 0; r < 20; ++r) {
