@@ -320,6 +320,7 @@ void IncrementIntegrator::set_view(const SurfacePoint& p) {
     extra_evaluations_ = 0;
     rays_ = 0;
     mixed_.clear();
+    shaft_lists_.clear();
     pieces_key_ = ~0ULL;
     if (planar_ && (options_.clip_horizon || occlusion_))
         view_ = blocked_view(plane_, p.position, p.normal, occlusion_,
@@ -422,17 +423,50 @@ void IncrementIntegrator::collect_shaft_occluders(const SurfacePoint& p, const Q
     // A polygon whose box misses the box of p and the cell, whose plane has them all on one
     // side, or whose bounding ball misses the capsule around the segment from p to the ball of
     // the nodes, cannot come between p and the cell.
+    // DESIGN: on a planar shooter the region is the whole cell (its four corners: the cell is
+    // a convex quadrilateral holding every node of both rules and of every cell inside it), so
+    // the n and n + 1 rules share one list and a cell's children filter their parent's list
+    // instead of the point's (shaft_lists_, kept until the next set_view). On a curved shooter
+    // the cell bulges past its corners: its nodes' ball, each rule on its own.
+    const Rect& r = cell.rect;
+    const Vec3 corners[4] = {
+        shooter_.surface->point(r.x0, r.y0), shooter_.surface->point(r.x1, r.y0),
+        shooter_.surface->point(r.x1, r.y1), shooter_.surface->point(r.x0, r.y1)};
+    const std::vector<int>* list = view_.use_rays ? &view_.occluders : &occlusion_->candidates;
+    std::uint64_t key = 0;
+    if (planar_) {
+        key = cell_key(cell);
+        const auto it = shaft_lists_.find(key);
+        if (it != shaft_lists_.end()) {
+            local_ = it->second;
+            return;
+        }
+        // The nearest ancestor's list (every polygon that can meet a segment to the child
+        // can meet one to the parent, which holds it).
+        for (QuadCell up = cell; up.level > 0;) {
+            up = QuadCell{up.level - 1, up.i / 2, up.j / 2, Rect{}};
+            const auto parent = shaft_lists_.find(cell_key(up));
+            if (parent != shaft_lists_.end()) {
+                list = &parent->second;
+                break;
+            }
+        }
+    }
     Box3 shaft, nodes;
     shaft.extend(p.position);
-    for (int i = 0; i < pts.count; ++i) nodes.extend(pts.first[i].x);
+    if (planar_)
+        for (const Vec3& c : corners) nodes.extend(c);
+    else
+        for (int i = 0; i < pts.count; ++i) nodes.extend(pts.first[i].x);
     shaft.extend(nodes);
-    const Rect& r = cell.rect;
-    for (const Vec2 c : {Vec2{r.x0, r.y0}, Vec2{r.x1, r.y0}, Vec2{r.x0, r.y1}, Vec2{r.x1, r.y1}})
-        shaft.extend(shooter_.surface->point(c.x, c.y));
+    for (const Vec3& c : corners) shaft.extend(c);
     const Vec3 c_nodes = nodes.centre();
     double r_nodes = 0;
-    for (int i = 0; i < pts.count; ++i)
-        r_nodes = std::max(r_nodes, length(pts.first[i].x - c_nodes));
+    if (planar_)
+        for (const Vec3& c : corners) r_nodes = std::max(r_nodes, length(c - c_nodes));
+    else
+        for (int i = 0; i < pts.count; ++i)
+            r_nodes = std::max(r_nodes, length(pts.first[i].x - c_nodes));
     // DESIGN: 1e-9 of the coordinates' size: rounding never drops a polygon a ray could meet.
     const double capsule_slack =
         1e-9 * (length(p.position) + length(c_nodes) + length(shaft.extent()));
@@ -450,17 +484,10 @@ void IncrementIntegrator::collect_shaft_occluders(const SurfacePoint& p, const Q
     // box and capsule tests kept 103 of the 223 occluders of a cell on average, each tested by
     // every node's ray.
     std::optional<Shaft> pyramid;
-    if (planar_) {
-        const Vec3 corners[4] = {shooter_.surface->point(r.x0, r.y0),
-                                 shooter_.surface->point(r.x1, r.y0),
-                                 shooter_.surface->point(r.x1, r.y1),
-                                 shooter_.surface->point(r.x0, r.y1)};
-        pyramid.emplace(p.position, corners);
-    }
+    if (planar_) pyramid.emplace(p.position, corners);
     const std::vector<Polygon>& polys = occlusion_->octree->polygons();
-    const std::vector<int>& list = view_.use_rays ? view_.occluders : occlusion_->candidates;
     local_.clear();
-    for (int id : list) {
+    for (int id : *list) {
         const Polygon& poly = polys[id];
         if (!overlaps(poly.bounds(), shaft)) continue;
         if (outside_capsule(poly.bounds())) continue;
@@ -486,6 +513,7 @@ void IncrementIntegrator::collect_shaft_occluders(const SurfacePoint& p, const Q
         if (lo > 0 || hi < 0) continue;
         local_.push_back(id);
     }
+    if (planar_) shaft_lists_.emplace(key, local_);
 }
 
 Rgb IncrementIntegrator::cell_value(const SurfacePoint& p, const QuadCell& cell, int n) {

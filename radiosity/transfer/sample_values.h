@@ -212,7 +212,8 @@ private:
     /// a curved shooter with an occlusion context.
     Rgb cell_value(const SurfacePoint& p, const QuadCell& cell, int n);
     /// Fills local_ with the occluders that can come between p and the nodes `pts` of `cell`
-    /// (ray visibility: a curved shooter, or too many occluders to project).
+    /// (ray visibility: a curved shooter, or too many occluders to project); on a planar
+    /// shooter those of the whole cell, kept per cell until the next set_view.
     void collect_shaft_occluders(const SurfacePoint& p, const QuadCell& cell, const PointSpan& pts);
     void set_view(const SurfacePoint& p);
     /// The near-field guard: the cell's nodes and corners span more than near_field times their
@@ -252,6 +253,9 @@ private:
     long rays_ = 0;                        // rays cast for the current point
     Rgb b_star_;                           // the constant subtracted from B_h (zero: none)
     std::vector<int> local_;               // scratch: the occluders of one cell's shaft
+    /// Per cell of a planar shooter, the occluders of its shaft from the current point (cleared
+    /// by set_view): collect_shaft_occluders filters a child's from its parent's.
+    std::unordered_map<std::uint64_t, std::vector<int>> shaft_lists_;
     RecentBlockers recent_blockers_;       // the last blockers of the nodes' rays, tried first
     std::vector<std::uint64_t> mixed_;     // cells whose nodes disagreed on visibility (curved), or
                                            //   cut cells above min_cut_level (planar): split
