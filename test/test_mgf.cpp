@@ -234,12 +234,27 @@ TEST_CASE(
     REQUIRE(i + 1 == s.surfaces.size());
     CHECK(s.surfaces[i].surface.kind() == Surface::Kind::Cylinder);
 
-    // A torus of radii 1 and 2 about z: bilinear patches of nearly 4 pi^2 R r, facing out.
-    const Scene t = mgf("m w =\n rd 0.5\nv o =\n p 0 0 0\n n 0 0 1\ntorus o 1 2\n");
-    CHECK(t.surfaces.size() >= 48);
-    CHECK(total_area(t) == Approx(4 * Pi * Pi * 1.5 * 0.5).epsilon(0.05));
-    const SurfacePoint outer = t.surfaces[0].surface.evaluate(0.5, 0.5);
-    CHECK(dot(outer.normal, outer.position) > 0);  // the outer equator's patch faces away
+    // A torus of radii 1 and 2 about z: planar quads of nearly 4 pi^2 R r, facing out (and in
+    // with negative radii). Each is one facet for rays: its cell of the torus is a trapezoid.
+    for (const char* radii : {"1 2", "-1 -2"}) {
+        CAPTURE(radii);
+        const Scene t = mgf(std::string("m w =\n rd 0.5\nv o =\n p 0 0 0\n n 0 0 1\ntorus o ") +
+                            radii + "\n");
+        CHECK(t.surfaces.size() >= 48);
+        CHECK(total_area(t) == Approx(4 * Pi * Pi * 1.5 * 0.5).epsilon(0.05));
+        const bool inward = radii[0] == '-';
+        for (const SceneSurface& x : t.surfaces) {
+            REQUIRE(x.surface.kind() == Surface::Kind::PlanarQuad);
+            CHECK(x.surface.tessellate(16).size() == 1);
+            // Out of the tube (or into it): the normal points away from the tube's circle.
+            const SurfacePoint q = x.surface.evaluate(0.5, 0.5);
+            const Vec3 radial = normalize(Vec3{q.position.x, q.position.y, 0});
+            CHECK(dot(q.normal, q.position - 1.5 * radial) * (inward ? -1 : 1) > 0);
+        }
+    }
+    // An inner radius of 0: the cells at the centre are triangles, nothing is refused.
+    const Scene t0 = mgf("m w =\n rd 0.5\nv o =\n p 0 0 0\n n 0 0 1\ntorus o 0 2\n");
+    CHECK(total_area(t0) == Approx(4 * Pi * Pi * 1 * 1).epsilon(0.05));
 
     // A prism, the MGF manual's example: the face (0 0 0) (0 1 0) (1 1 0) (1 0 0) looks down
     // (-z), and a positive length extrudes it the other way: the unit cube, every side out.

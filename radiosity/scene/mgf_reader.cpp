@@ -753,7 +753,13 @@ private:
         add(line, Surface::disk(c, normal, e1, r0, r1, 0, 2 * Pi));
     }
 
-    /// torus centre r_inner r_outer: bilinear patches around the tube (mbr has no torus).
+    /// torus centre r_inner r_outer: planar quads around the tube (mbr has no torus). A cell's
+    /// corners at two angles around the axis and two around the tube form an isosceles trapezoid
+    /// (its two edges along the axis's circles are parallel), so each cell is planar.
+    /// DESIGN: planar quads, as the cone's sides, not bilinear patches: the patches were
+    /// tessellated 16 x 16 for rays (512 triangles each, 65,536 for corridor.mgf's ring) to
+    /// follow a surface that is flat, and a planar receiver or shooter takes the exact clipped
+    /// visibility that a curved one does not.
     void torus(const Line& line) {
         if (line.size() != 4) line.fail("'torus' needs a centre vertex and two radii");
         const MgfVertex& v = vertex_named(line, line[1]);
@@ -776,10 +782,12 @@ private:
         };
         for (int i = 0; i < nu; ++i)
             for (int j = 0; j < nv; ++j) {
-                // Corners counter-clockwise seen from outside the tube.
-                Vec3 q[4] = {at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)};
-                if (inward) std::swap(q[1], q[3]);
-                add(line, Surface::bilinear_patch(q[0], q[1], q[2], q[3]));
+                // Corners counter-clockwise seen from outside the tube (at an inner radius of
+                // 0 two corners meet at the centre: face_to_quads makes the triangle).
+                std::vector<Vec3> q{at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)};
+                if (inward) std::reverse(q.begin(), q.end());
+                for (const Quad& x : face_to_quads(line, q))
+                    add(line, Surface::planar_quad(x[0], x[1], x[2], x[3]));
             }
     }
 
