@@ -309,3 +309,80 @@ TEST_CASE("convex solids: many faces but few solids are projected and not ray-ca
     CHECK(shadowed > 100);
     CHECK(lit > 100);
 }
+
+TEST_CASE("convex solids: a whole tessellated sphere is one solid, its silhouette its facets'",
+          "[shadow][convex_solids]") {
+    // A whole sphere's facets bound one convex polyhedron (max_solid_faces is 1024): one shadow
+    // caster instead of hundreds of loose facets. At 16 and 24 facets a turn (256 and 576
+    // faces, both over the cap of 64 before), centred at the origin with its pole along y,
+    // where the corners at the seam and the poles need not agree to the bit (sin(2 pi) and
+    // sin(pi) are 1e-16, not 0); it fails with the old cap. Its silhouette
+    // from points under a ceiling shooter against the facets themselves: a point of the
+    // shooter's plane lies in the silhouette exactly when the segment to it meets a facet,
+    // checked on a 60 x 60 grid (away from the silhouette's outline by 1e-9 of the shooter's size).
+    const Surface shooter =
+        Surface::planar_quad({-2.5, 3, -2.5}, {2.5, 3, -2.5}, {2.5, 3, 2.5}, {-2.5, 3, 2.5});
+    const ShooterPlane plane = make_shooter_plane(shooter);
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> u(-2, 2), v(-1.2, -0.7);
+    auto outline_distance = [](const ConvexPolygon& poly, Vec2 q) {
+        double d = HUGE_VAL;
+        for (size_t k = 0; k < poly.size(); ++k) {
+            const Vec2 a = poly[k], b = poly[(k + 1) % poly.size()];
+            const Vec2 ab{b.x - a.x, b.y - a.y}, aq{q.x - a.x, q.y - a.y};
+            const double t =
+                std::clamp((ab.x * aq.x + ab.y * aq.y) / (ab.x * ab.x + ab.y * ab.y), 0.0, 1.0);
+            d = std::min(d, std::hypot(aq.x - t * ab.x, aq.y - t * ab.y));
+        }
+        return d;
+    };
+    for (const int resolution : {16, 24}) {
+        const Surface sphere =
+            Surface::sphere({0, 0, 0}, {0, 1, 0}, {1, 0, 0}, 0.61, 0, Pi, 0, 2 * Pi, false);
+        std::vector<Polygon> facets;
+        for (const Facet& f : sphere.tessellate(resolution))
+            facets.emplace_back(f.vertices, f.uv, 0);
+        CAPTURE(resolution, facets.size());
+        REQUIRE(facets.size() == size_t(resolution * resolution));
+        const ConvexSolids solids = find_convex_solids(facets);
+        REQUIRE(solids.solids.size() == 1);
+        CHECK(solids.solids[0].polygons.size() == facets.size());
+        CHECK_FALSE(solids.solids[0].open);
+        int inside = 0, outside = 0;
+        for (int k = 0; k < 3; ++k) {
+            const Vec3 p{u(rng), v(rng), u(rng)};
+            const double h_p = dot(plane.normal, p - plane.origin);
+            REQUIRE(h_p > 0);
+            const std::optional<ConvexPolygon> silhouette =
+                solid_shadow(plane, p, h_p, solids.solids[0]);
+            REQUIRE(silhouette);
+            REQUIRE(!silhouette->empty());
+            Rect box{HUGE_VAL, -HUGE_VAL, HUGE_VAL, -HUGE_VAL};
+            for (const Vec2& q : plane.outline) {
+                box.x0 = std::min(box.x0, q.x);
+                box.x1 = std::max(box.x1, q.x);
+                box.y0 = std::min(box.y0, q.y);
+                box.y1 = std::max(box.y1, q.y);
+            }
+            for (int i = 0; i < 60; ++i)
+                for (int j = 0; j < 60; ++j) {
+                    const Vec2 q{box.x0 + (i + 0.5) / 60 * (box.x1 - box.x0),
+                                 box.y0 + (j + 0.5) / 60 * (box.y1 - box.y0)};
+                    if (outline_distance(*silhouette, q) <= 1e-9 * plane.size) continue;
+                    const Vec3 x = plane.to_space(q);
+                    const Ray ray{p, x - p, 1e-9, 1 - 1e-9};
+                    bool blocked = false;
+                    for (const Polygon& f : facets)
+                        if (f.intersect_segment(ray)) {
+                            blocked = true;
+                            break;
+                        }
+                    CAPTURE(p, q);
+                    CHECK(contains(*silhouette, q) == blocked);
+                    (blocked ? inside : outside) += 1;
+                }
+        }
+        CHECK(inside > 100);  // the silhouette covers part of the grid, not all of it
+        CHECK(outside > 100);
+    }
+}

@@ -43,9 +43,13 @@ struct ConvexSolids {
     std::vector<int> solid_of;  // per polygon: the index of its solid, or -1
 };
 
-/// Solids with more faces than this are not looked for (their silhouettes cost more than the
-/// faces' projections would save, and exact visibility projects at most exact_limit occluders).
-constexpr int max_solid_faces = 64;
+/// Solids with more faces than this are not looked for (a silhouette's cost grows with the
+/// solid's corners, its hull's with their logarithm too).
+/// DESIGN: 1024, so that a tessellated sphere (256 facets at the default tessellation 16, 576 at
+/// the room's 24) is one caster: at 64 its facets were loose, each counted against exact_limit,
+/// and a point that saw the sphere cast one ray per quadrature node. corridor.mgf's sphere: 89.6
+/// -> 71.3 s at the defaults, 137 -> 53 M rays (docs/method.md, "Shadows").
+constexpr int max_solid_faces = 1024;
 
 /// The convex solids among `polygons` (linear in their number: vertices matched by their bits).
 ConvexSolids find_convex_solids(const std::vector<Polygon>& polygons);
