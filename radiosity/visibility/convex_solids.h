@@ -48,7 +48,7 @@ struct ConvexSolids {
 /// DESIGN: 1024, so that a tessellated sphere (256 facets at the default tessellation 16, 576 at
 /// the room's 24) is one caster: at 64 its facets were loose, each counted against exact_limit,
 /// and a point that saw the sphere cast one ray per quadrature node. corridor.mgf's sphere: 89.6
-/// -> 71.3 s at the defaults, 137 -> 53 M rays (docs/method.md, "Shadows").
+/// -> 68.3 s at the defaults, 137 -> 53 M rays (docs/method.md, "Shadows").
 constexpr int max_solid_faces = 1024;
 
 /// The convex solids among `polygons` (linear in their number: vertices matched by their bits).
