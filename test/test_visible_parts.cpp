@@ -509,6 +509,25 @@ TEST_CASE("shadow: a shooter sharing an edge with its receiver is not cut by its
     CHECK(points == 7 * 2 * 6);
 }
 
+/// A unit shooter at z = 1 facing down over a unit receiver at z = 0, with n random triangles
+/// about 0.08 wide between them: polygon 0 the shooter, 1 the receiver, 2 + k triangle k.
+struct TriangleCloud {
+    Surface shooter = Surface::planar_quad({0, 0, 1}, {0, 1, 1}, {1, 1, 1}, {1, 0, 1});
+    Surface receiver = Surface::planar_quad({0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0});
+    std::vector<Polygon> polygons;
+};
+
+static TriangleCloud triangle_cloud(std::mt19937& rng, int n) {
+    std::uniform_real_distribution<double> u(0, 1);
+    TriangleCloud cloud;
+    cloud.polygons.push_back(make_polygon(quad_polygon(cloud.shooter), 0));
+    cloud.polygons.push_back(make_polygon(quad_polygon(cloud.receiver), 1));
+    for (int i = 0; i < n; ++i)
+        cloud.polygons.push_back(
+            make_polygon(random_triangle(rng, {u(rng), u(rng), 0.1 + 0.8 * u(rng)}, 0.08), 2 + i));
+    return cloud;
+}
+
 TEST_CASE("shadow: occluders_toward with a limit gives the whole list or more than the limit",
           "[shadow][visible_parts]") {
     // A unit shooter at z = 1 facing down over a unit receiver at z = 0, with 150 random
@@ -518,15 +537,9 @@ TEST_CASE("shadow: occluders_toward with a limit gives the whole list or more th
     // paper's fractions then cast their rays through the octree, which needs no list).
     std::mt19937 rng(77);
     std::uniform_real_distribution<double> u(0, 1);
-    const Surface shooter = Surface::planar_quad({0, 0, 1}, {0, 1, 1}, {1, 1, 1}, {1, 0, 1});
-    const Surface receiver = Surface::planar_quad({0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0});
-    std::vector<Polygon> polygons;
-    polygons.push_back(make_polygon(quad_polygon(shooter), 0));
-    polygons.push_back(make_polygon(quad_polygon(receiver), 1));
-    for (int i = 0; i < 150; ++i)
-        polygons.push_back(
-            make_polygon(random_triangle(rng, {u(rng), u(rng), 0.1 + 0.8 * u(rng)}, 0.08), 2 + i));
-    const Octree octree(polygons, OctreeOptions{6, 4});
+    const TriangleCloud cloud = triangle_cloud(rng, 150);
+    const Surface &shooter = cloud.shooter, &receiver = cloud.receiver;
+    const Octree octree(cloud.polygons, OctreeOptions{6, 4});
     const OcclusionContext ctx = make_occlusion_context(octree, shooter, 0, receiver, 1, 0);
     REQUIRE(static_cast<int>(ctx.candidates.size()) > exact_limit);
     const ShooterPlane plane = make_shooter_plane(shooter);
@@ -568,14 +581,9 @@ TEST_CASE("shadow: ray visibility on a planar shooter keeps every occluder of a 
     // the lists shadows up to a few percent of the shooter. Within 4e-3 of F.
     std::mt19937 rng(91);
     std::uniform_real_distribution<double> u(0, 1);
-    const Surface shooter = Surface::planar_quad({0, 0, 1}, {0, 1, 1}, {1, 1, 1}, {1, 0, 1});
-    const Surface receiver = Surface::planar_quad({0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0});
-    std::vector<Polygon> polygons;
-    polygons.push_back(make_polygon(quad_polygon(shooter), 0));
-    polygons.push_back(make_polygon(quad_polygon(receiver), 1));
-    for (int i = 0; i < 150; ++i)
-        polygons.push_back(
-            make_polygon(random_triangle(rng, {u(rng), u(rng), 0.1 + 0.8 * u(rng)}, 0.08), 2 + i));
+    const TriangleCloud cloud = triangle_cloud(rng, 150);
+    const Surface &shooter = cloud.shooter, &receiver = cloud.receiver;
+    const std::vector<Polygon>& polygons = cloud.polygons;
     const Octree octree(polygons, OctreeOptions{6, 4});
     const OcclusionContext ctx = make_occlusion_context(octree, shooter, 0, receiver, 1, 0);
     const Shooter unit = unit_shooter(shooter);
