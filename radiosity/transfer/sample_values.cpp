@@ -428,10 +428,6 @@ void IncrementIntegrator::collect_shaft_occluders(const SurfacePoint& p, const Q
     // the n and n + 1 rules share one list and a cell's children filter their parent's list
     // instead of the point's (shaft_lists_, kept until the next set_view). On a curved shooter
     // the cell bulges past its corners: its nodes' ball, each rule on its own.
-    const Rect& r = cell.rect;
-    const Vec3 corners[4] = {
-        shooter_.surface->point(r.x0, r.y0), shooter_.surface->point(r.x1, r.y0),
-        shooter_.surface->point(r.x1, r.y1), shooter_.surface->point(r.x0, r.y1)};
     const std::vector<int>* list = view_.use_rays ? &view_.occluders : &occlusion_->candidates;
     std::uint64_t key = 0;
     if (planar_) {
@@ -452,6 +448,10 @@ void IncrementIntegrator::collect_shaft_occluders(const SurfacePoint& p, const Q
             }
         }
     }
+    const Rect& r = cell.rect;
+    const Vec3 corners[4] = {
+        shooter_.surface->point(r.x0, r.y0), shooter_.surface->point(r.x1, r.y0),
+        shooter_.surface->point(r.x1, r.y1), shooter_.surface->point(r.x0, r.y1)};
     Box3 shaft, nodes;
     shaft.extend(p.position);
     if (planar_)

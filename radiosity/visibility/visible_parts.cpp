@@ -357,7 +357,8 @@ BlockedView blocked_view(const ShooterPlane& plane, Vec3 p, Vec3 n_p,
     // DESIGN: exact_limit counts these casters, not polygons: a box standing in the way is one
     // shadow, not six (scene_scaling's room of 17 blocks, 102 faces, took one ray per
     // quadrature node at every receiving point when the faces were counted).
-    std::vector<int> near_p, near_solids, near_loose;
+    std::vector<int> near_p;
+    ShadowCasters near;  // near_p's casters
     const std::vector<int>* occluders = &context->candidates;
     const std::vector<int>* solid_ids = &context->solid_ids;
     const std::vector<int>* loose = context->solids ? &context->loose : &context->candidates;
@@ -369,12 +370,10 @@ BlockedView blocked_view(const ShooterPlane& plane, Vec3 p, Vec3 n_p,
         // instead of projection.
         // (The grouping stops once the casters pass the limit: rays then, whatever the rest.)
         near_p = occluders_toward(*context, plane, p);
-        ShadowCasters near = casters_among(*context, near_p, exact_limit);
-        near_solids = std::move(near.solids);
-        near_loose = std::move(near.loose);
+        near = casters_among(*context, near_p, exact_limit);
         occluders = &near_p;
-        solid_ids = &near_solids;
-        loose = &near_loose;
+        solid_ids = &near.solids;
+        loose = &near.loose;
         if (casters() > exact_limit) {
             view.use_rays = true;
             view.occluders = std::move(near_p);
