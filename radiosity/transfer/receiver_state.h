@@ -69,6 +69,13 @@ constexpr double fit_share = 2;
 constexpr double contact_split_reach = 0.5;
 /// ... and asks the contact oracle's test (contact_oracle_test) of a cell within this share.
 constexpr double contact_test_reach = 0.25;
+/// The thin rim rule (part of the contact rule in scenes, oracle.cpp; ReceiverOptions::thin_rim)
+/// splits a cell on the rim of a hidden region more than this many times thinner than the cell.
+/// DESIGN (docs/method.md, "Hidden
+/// regions"): 3 takes the wall of corridor.mgf to level 4 along a board's strip (0.3 m of a 10 m
+/// wall), 12 % -> 0.3 % 22 cm under the board, and leaves a block's footprint on a floor (as
+/// wide as the cells there) to the hidden rim rule: the Cornell box's count is unchanged.
+constexpr double thin_rim_ratio = 3;
 
 /// How the increment is continued outside [0,1]^2 (section 6, "Extrapolation").
 enum class Extrapolation {
@@ -125,6 +132,9 @@ struct ReceiverOptions {
                                        //   whatever the oracle says: along an edge shared with
                                        //   the shooter dB grows like d log d, whose cell means
                                        //   agree long before the spline can follow it (0: off)
+    double thin_rim = 0;               // > 0: the thin rim rule (oracle.cpp) splits a cell on the
+                                       //   rim of a hidden region more than this many times
+                                       //   thinner than the cell (scenes: thin_rim_ratio; 0: off)
     OracleTest contact_oracle_test =
         OracleTest::Means;          // beyond the paper: the oracle's
                                     //   test in cells that touch a planar shooter

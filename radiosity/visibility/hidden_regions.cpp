@@ -54,6 +54,37 @@ HiddenMask::HiddenMask(int n, std::vector<std::uint8_t> hidden)
             }
         }
     }
+    // Each hidden region's thickness (its texels 8-connected): twice the largest distance from
+    // one of its texels to its substitute, the nearest visible texel.
+    thickness_.assign(hidden_.size(), 0.0f);
+    std::vector<int> region, stack;
+    std::vector<std::uint8_t> seen(hidden_.size(), 0);
+    for (int start = 0; start < n * n; ++start) {
+        if (!hidden_[start] || seen[start]) continue;
+        region.clear();
+        stack.assign(1, start);
+        seen[start] = 1;
+        double deepest = 0;
+        while (!stack.empty()) {
+            const int k = stack.back();
+            stack.pop_back();
+            region.push_back(k);
+            const int i = k % n, j = k / n;
+            const Vec2 d = substitute_[k] - Vec2{(i + 0.5) / n, (j + 0.5) / n};
+            deepest = std::max(deepest, std::sqrt(dot(d, d)));
+            for (int dj = -1; dj <= 1; ++dj)
+                for (int di = -1; di <= 1; ++di) {
+                    const int a = i + di, b = j + dj;
+                    if (a < 0 || a >= n || b < 0 || b >= n) continue;
+                    const int q = b * n + a;
+                    if (hidden_[q] && !seen[q]) {
+                        seen[q] = 1;
+                        stack.push_back(q);
+                    }
+                }
+        }
+        for (int k : region) thickness_[k] = static_cast<float>(2 * deepest);
+    }
 }
 
 int HiddenMask::texel(double s, double t) const {
@@ -75,6 +106,24 @@ bool HiddenMask::mixed(double s0, double s1, double t0, double t1) const {
         for (int i = i0; i <= i1; ++i) {
             (hidden_[size_t(j) * n_ + i] ? seen_hidden : seen_visible) = true;
             if (seen_hidden && seen_visible) return true;
+        }
+    return false;
+}
+
+bool HiddenMask::thin_rim(double s0, double s1, double t0, double t1, double ratio) const {
+    if (n_hidden_ == 0 || thickness_.empty()) return false;  // nothing or everything hidden
+    const int first = texel(s0, t0), last = texel(s1, t1);
+    const int i0 = first % n_, j0 = first / n_, i1 = last % n_, j1 = last / n_;
+    const double side = std::min(s1 - s0, t1 - t0);
+    bool seen_visible = false, seen_thin = false;
+    for (int j = j0; j <= j1; ++j)
+        for (int i = i0; i <= i1; ++i) {
+            const size_t k = size_t(j) * n_ + i;
+            if (!hidden_[k])
+                seen_visible = true;
+            else if (ratio * thickness_[k] < side)
+                seen_thin = true;
+            if (seen_visible && seen_thin) return true;
         }
     return false;
 }

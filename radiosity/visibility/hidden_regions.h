@@ -38,6 +38,12 @@ public:
     /// that only touches the rectangle's far edge s1 or t1 counts (a dyadic cell then looks one
     /// texel beyond its own: a rim found a little early, never missed).
     bool mixed(double s0, double s1, double t0, double t1) const;
+    /// True when the rectangle holds part of a hidden region's rim (as `mixed`) and the
+    /// narrowest hidden region it meets is thin beside it: its thickness (twice the largest
+    /// distance from one of its texels' centres to the nearest visible texel's centre, in
+    /// [0,1]^2) times `ratio` is below the rectangle's shorter side. The strip a shelf hides on
+    /// a wall is such a region, the footprint of a block on a floor is not.
+    bool thin_rim(double s0, double s1, double t0, double t1, double ratio) const;
 
 private:
     int texel(double s, double t) const;
@@ -45,6 +51,7 @@ private:
     int n_hidden_ = 0;
     std::vector<std::uint8_t> hidden_;
     std::vector<Vec2> substitute_;  // per texel (its own centre when visible)
+    std::vector<float> thickness_;  // per hidden texel: its region's thickness (thin_rim)
 };
 
 /// What find_contacts finds: the polygons in contact with each surface, and the scene's convex
