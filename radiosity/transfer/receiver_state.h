@@ -71,10 +71,10 @@ constexpr double contact_split_reach = 0.5;
 constexpr double contact_test_reach = 0.25;
 /// The thin rim rule (part of the contact rule in scenes, oracle.cpp; ReceiverOptions::thin_rim)
 /// splits a cell on the rim of a hidden region more than this many times thinner than the cell.
-/// DESIGN (docs/method.md, "Hidden
-/// regions"): 3 takes the wall of corridor.mgf to level 4 along a board's strip (0.3 m of a 10 m
-/// wall), 12 % -> 0.3 % 22 cm under the board, and leaves a block's footprint on a floor (as
-/// wide as the cells there) to the hidden rim rule: the Cornell box's count is unchanged.
+/// DESIGN (docs/method.md, "Hidden regions"): 3 takes the wall of corridor.mgf to level 4 along
+/// a board's strip (0.3 m of a 10 m wall), 12 % -> 0.3 % 22 cm under the board, and leaves a
+/// block's footprint on a floor (as wide as the cells there) to the hidden rim rule: the Cornell
+/// box's count is unchanged.
 constexpr double thin_rim_ratio = 3;
 
 /// How the increment is continued outside [0,1]^2 (section 6, "Extrapolation").
