@@ -148,6 +148,26 @@ TEST_CASE("mgf: faces, objects' names and the faces' sides", "[mgf]") {
     CHECK(two.surfaces[1].surface.normal(0.5, 0.5).z == Approx(-1));
 }
 
+TEST_CASE("mgf: a quad written as two triangles is one surface (MGF and OBJ)", "[mgf][obj]") {
+    // The unit square's halves, the diagonal a-c walked both ways; then the same halves in two
+    // materials, which stay three quads each.
+    const Scene s = mgf(std::string(square_vertices) + "f a b c\nf a c d\n");
+    REQUIRE(s.surfaces.size() == 1);
+    CHECK(s.surfaces[0].surface.area() == Approx(1));
+    CHECK(s.surfaces[0].surface.normal(0.5, 0.5).z == Approx(1));
+    const Scene two =
+        mgf(std::string(square_vertices) + "f a b c\nm white =\n c\n rd 0.8\nf a c d\n");
+    CHECK(two.surfaces.size() == 6);
+    CHECK(total_area(two) == Approx(1));
+    // A cube's face of two triangles, repeated as the quad itself: the repeat is found.
+    const Scene again = mgf(std::string(square_vertices) + "f a b c\nf a c d\nf b c d a\n");
+    CHECK(again.surfaces.size() == 1);
+    std::istringstream obj("v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3\nf 1 3 4\n");
+    const Scene o = parse_obj(obj, "t.obj");
+    REQUIRE(o.surfaces.size() == 1);
+    CHECK(o.surfaces[0].surface.area() == Approx(1));
+}
+
 TEST_CASE("mgf: xf moves, turns, scales and mirrors; arrays repeat their lines", "[mgf]") {
     SECTION("translation, rotation and scale") {
         const Scene s = mgf(std::string(square_vertices) +

@@ -3,6 +3,7 @@
 // its message at the right line, and OBJ faces become the quads docs/scene-format.md promises.
 #include <unistd.h>
 
+#include <algorithm>
 #include <catch2/catch.hpp>
 #include <cerrno>
 #include <cstring>
@@ -223,6 +224,62 @@ TEST_CASE("scene_io: planarity is relative to the quad's size", "[scene_io]") {
         CHECK_THAT(planar_quad_problem(q), Contains("not planar"));
         q[2].z = 0.005 * scale;  // 0.09% of the diagonal: planar enough
         CHECK(planar_quad_problem(q).empty());
+    }
+}
+
+TEST_CASE("scene_io: triangles that share an edge join into one quad", "[scene_io]") {
+    using detail::pair_triangles;
+    using detail::Triangle;
+    const Vec3 a{0, 0, 0}, b{2, 0, 0}, c{2, 1, 0}, d{0, 1, 0};
+    SECTION("a rectangle's two halves, the diagonal walked both ways") {
+        const auto pairs = pair_triangles({Triangle{{a, b, c}, 0}, Triangle{{a, c, d}, 0}});
+        REQUIRE(pairs.partner == std::vector<int>{1, 0});
+        const detail::Quad& q = pairs.quad[0];
+        const Surface quad = Surface::planar_quad(q[0], q[1], q[2], q[3]);
+        CHECK(quad.area() == Approx(2));
+        CHECK(quad.normal(0.5, 0.5).z == Approx(1));  // the triangles' front
+        for (Vec3 corner : {a, b, c, d}) CHECK(std::count(q.begin(), q.end(), corner) == 1);
+    }
+    SECTION("not joined: another group, the other front, a fold, a flat corner, no shared edge") {
+        CHECK(pair_triangles({Triangle{{a, b, c}, 0}, Triangle{{a, c, d}, 1}}).partner ==
+              std::vector<int>{-1, -1});
+        CHECK(pair_triangles({Triangle{{a, b, c}, 0}, Triangle{{a, d, c}, 0}}).partner ==
+              std::vector<int>{-1, -1});
+        const Vec3 up{0, 1, 1};  // the second half bent up about the diagonal
+        CHECK(pair_triangles({Triangle{{a, b, c}, 0}, Triangle{{a, c, up}, 0}}).partner ==
+              std::vector<int>{-1, -1});
+        // A third corner nearly on the line through c and a: the quad's corner at a is 162
+        // degrees, more than max_pair_angle.
+        const Vec3 flat{-2, -0.65, 0};
+        CHECK(pair_triangles({Triangle{{a, b, c}, 0}, Triangle{{a, c, flat}, 0}}).partner ==
+              std::vector<int>{-1, -1});
+        CHECK(pair_triangles(
+                  {Triangle{{a, b, c}, 0}, Triangle{{d, Vec3{0, 2, 0}, Vec3{-1, 1, 0}}, 0}})
+                  .partner == std::vector<int>{-1, -1});
+    }
+    SECTION("a strip of three squares, each cut along a diagonal: each square's halves join") {
+        // Triangle 0 could also join triangle 3 across the edge p1-q1 (a parallelogram whose
+        // largest angle is 135 degrees); its own square's other half (90) is taken instead.
+        const Vec3 p[4] = {{0, 0, 0}, {1, 0, 0}, {2, 0, 0}, {3, 0, 0}};
+        const Vec3 q[4] = {{0, 1, 0}, {1, 1, 0}, {2, 1, 0}, {3, 1, 0}};
+        std::vector<Triangle> strip;
+        for (int k = 0; k < 3; ++k) {
+            strip.push_back(Triangle{{p[k], p[k + 1], q[k + 1]}, 0});
+            strip.push_back(Triangle{{p[k], q[k + 1], q[k]}, 0});
+        }
+        const auto pairs = pair_triangles(strip);
+        CHECK(pairs.partner == std::vector<int>{1, 0, 3, 2, 5, 4});
+        for (int t : {0, 2, 4}) {
+            const detail::Quad& x = pairs.quad[size_t(t)];
+            CHECK(Surface::planar_quad(x[0], x[1], x[2], x[3]).area() == Approx(1));
+        }
+    }
+    SECTION("a square cut along both diagonals stays four triangles") {
+        // Two neighbours' union is a triangle with the centre on its edge: a corner of 180.
+        const Vec3 m{1, 0.5, 0};
+        const auto pairs = pair_triangles({Triangle{{a, b, m}, 0}, Triangle{{b, c, m}, 0},
+                                           Triangle{{c, d, m}, 0}, Triangle{{d, a, m}, 0}});
+        CHECK(pairs.partner == std::vector<int>{-1, -1, -1, -1});
     }
 }
 

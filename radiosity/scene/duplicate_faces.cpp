@@ -267,15 +267,7 @@ void drop_duplicate_surfaces(Scene& scene, const ImportOptions& options) {
                                  "so remove one of them");
     std::vector<char> drop(scene.surfaces.size(), 0);
     for (int i : other_material) drop[size_t(i)] = 1;
-    const auto drop_marked = [&] {
-        size_t k = 0;
-        for (size_t i = 0; i < scene.surfaces.size(); ++i)
-            if (!drop[i]) {
-                if (k != i) scene.surfaces[k] = std::move(scene.surfaces[i]);
-                ++k;
-            }
-        scene.surfaces.resize(k);
-    };
+    const auto drop_marked = [&] { remove_surfaces(scene, drop); };
     if (repeats.empty()) {
         drop_marked();
         return;

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 
 namespace mbr {
 
@@ -298,6 +299,75 @@ std::vector<Quad> face_to_quads(const Line& line, std::vector<Vec3> p) {
     for (Quad& q : quads)
         for (Vec3& x : q) x = x + origin;
     return quads;
+}
+
+namespace {
+
+/// The largest interior angle of a planar quad, in degrees.
+double largest_angle(const Quad& q) {
+    double largest = 0;
+    for (size_t i = 0; i < 4; ++i) {
+        const Vec3 a = q[(i + 3) % 4] - q[i], b = q[(i + 1) % 4] - q[i];
+        const double l = length(a) * length(b);
+        if (l <= 0) return 180;
+        largest = std::max(largest, std::acos(std::clamp(dot(a, b) / l, -1.0, 1.0)));
+    }
+    return largest * 180 / M_PI;
+}
+
+/// A directed edge by its ends' exact coordinates, as a map key.
+using EdgeKey = std::array<double, 6>;
+EdgeKey edge_key(Vec3 from, Vec3 to) {
+    return {from.x, from.y, from.z, to.x, to.y, to.z};
+}
+
+}  // namespace
+
+TrianglePairs pair_triangles(const std::vector<Triangle>& triangles) {
+    const int n = static_cast<int>(triangles.size());
+    TrianglePairs pairs;
+    pairs.partner.assign(size_t(n), -1);
+    pairs.quad.resize(size_t(n));
+    // Each directed edge to the triangles (and their corner index) that walk it.
+    std::map<EdgeKey, std::vector<std::pair<int, int>>> edges;
+    for (int t = 0; t < n; ++t)
+        for (int k = 0; k < 3; ++k) {
+            const auto& c = triangles[size_t(t)].corner;
+            edges[edge_key(c[size_t(k)], c[size_t((k + 1) % 3)])].push_back({t, k});
+        }
+    for (int t = 0; t < n; ++t) {
+        if (pairs.partner[size_t(t)] >= 0) continue;
+        const Triangle& a = triangles[size_t(t)];
+        int best = -1;
+        double best_angle = max_pair_angle;
+        Quad best_quad{};
+        for (int k = 0; k < 3; ++k) {
+            // Edge k runs from corner k to corner k + 1; a partner walks it back.
+            const Vec3 from = a.corner[size_t(k)], to = a.corner[size_t((k + 1) % 3)];
+            const auto it = edges.find(edge_key(to, from));
+            if (it == edges.end()) continue;
+            for (const auto& [u, j] : it->second) {
+                if (u <= t || pairs.partner[size_t(u)] >= 0) continue;
+                const Triangle& b = triangles[size_t(u)];
+                if (b.group != a.group) continue;
+                const Vec3 third = b.corner[size_t((j + 2) % 3)];
+                // a's corners from the one after the edge: k + 2, k, then b's third, k + 1.
+                const Quad q{a.corner[size_t((k + 2) % 3)], from, third, to};
+                if (!planar_quad_problem(q).empty()) continue;
+                const double angle = largest_angle(q);
+                if (angle <= best_angle && (best < 0 || angle < best_angle)) {
+                    best = u;
+                    best_angle = angle;
+                    best_quad = q;
+                }
+            }
+        }
+        if (best < 0) continue;
+        pairs.partner[size_t(t)] = best;
+        pairs.partner[size_t(best)] = t;
+        pairs.quad[size_t(t)] = best_quad;
+    }
+    return pairs;
 }
 
 }  // namespace detail

@@ -45,6 +45,33 @@ void check_point(const Line& line, Vec3 p, const std::string& what);
 /// A degenerate or self-intersecting face fails `line`.
 std::vector<Quad> face_to_quads(const Line& line, std::vector<Vec3> p);
 
+/// One triangle of an imported face, for pair_triangles: its corners in the face's order (its
+/// front is the side (b - a) x (c - a) faces) and the group it may be joined within (the same
+/// material and surface name).
+struct Triangle {
+    std::array<Vec3, 3> corner;
+    int group = 0;
+};
+
+/// Largest interior angle, in degrees, of a quad that pair_triangles makes: flatter corners
+/// would leave the bilinear map's area factor A(u, v) of eq. (4) near zero there.
+constexpr double max_pair_angle = 160;
+
+/// Triangles joined in pairs into planar quads (docs/scene-format.md, "Triangle pairs"): two
+/// triangles of one group that share an edge, walked in opposite directions (the same front),
+/// become the quad of their four corners when it is a valid planar quad (planar_quad_problem)
+/// with no interior angle above max_pair_angle. Greedy in the triangles' order: each triangle
+/// not yet joined takes, among the later ones not yet joined, the partner whose quad has the
+/// smallest largest angle (ties to the first found, by the triangle's edges in order). Shared edges
+/// are found by exact equality of the corners (the files name the same vertex). Returns partner[t]
+/// (-1 for none) and, for the first triangle t of each pair, quad[t]: the first triangle's corners
+/// with the partner's third corner between the shared edge's ends, in the first triangle's turn.
+struct TrianglePairs {
+    std::vector<int> partner;
+    std::vector<Quad> quad;
+};
+TrianglePairs pair_triangles(const std::vector<Triangle>& triangles);
+
 }  // namespace detail
 
 }  // namespace mbr

@@ -628,8 +628,10 @@ private:
             line.fail("face has " + std::to_string(p.size()) + " vertices; at most " +
                       std::to_string(max_face_vertices) + " are accepted");
         if (world().mirrors()) std::reverse(p.begin(), p.end());  // the same side stays in front
-        for (const Quad& q : face_to_quads(line, p))
-            add(line, Surface::planar_quad(q[0], q[1], q[2], q[3]));
+        const std::vector<Quad> quads = face_to_quads(line, p);
+        if (p.size() == 3 && quads.size() == 3)
+            record_triangle(scene_.surfaces.size(), {p[0], p[1], p[2]});
+        for (const Quad& q : quads) add(line, Surface::planar_quad(q[0], q[1], q[2], q[3]));
     }
 
     /// fh v1 ... [- h1 ... [- ...]]: each hole joined to the contour along a seam between their

@@ -9,6 +9,7 @@
 #include <fstream>
 #include <istream>
 #include <limits>
+#include <map>
 #include <memory>
 #include <unordered_set>
 
@@ -328,6 +329,8 @@ private:
             fit = std::make_unique<FaceCoordinates>(p, uv);
             coordinates = fit.get();
         }
+        if (p.size() == 3 && quads.size() == 3)
+            record_triangle(scene_.surfaces.size(), {p[0], p[1], p[2]});
         for (size_t k = 0; k < quads.size(); ++k) {
             const Quad& q = quads[k];
             SceneSurface s;
@@ -615,7 +618,38 @@ void ImportReader::fault(const Line& line, const std::string& kind, const std::s
     warn(kind, line.file, line.number, message + "; " + then);
 }
 
+void ImportReader::record_triangle(size_t first, const std::array<Vec3, 3>& corners) {
+    triangles_.push_back({first, corners});
+}
+
+void ImportReader::join_triangle_pairs() {
+    if (triangles_.empty()) return;
+    // Groups: one per (material, name) of the triangles' first quads.
+    std::map<std::pair<int, std::string>, int> groups;
+    std::vector<Triangle> triangles;
+    for (const auto& [first, corners] : triangles_) {
+        const SceneSurface& s = scene_.surfaces[first];
+        const int group =
+            groups.emplace(std::make_pair(s.material, s.name), int(groups.size())).first->second;
+        triangles.push_back({corners, group});
+    }
+    const TrianglePairs pairs = pair_triangles(triangles);
+    std::vector<char> drop(scene_.surfaces.size(), 0);
+    for (size_t t = 0; t < triangles_.size(); ++t) {
+        const int u = pairs.partner[t];
+        if (u < 0 || size_t(u) < t) continue;
+        const size_t first = triangles_[t].first, other = triangles_[size_t(u)].first;
+        const Quad& q = pairs.quad[t];
+        scene_.surfaces[first].surface = Surface::planar_quad(q[0], q[1], q[2], q[3]);
+        drop[first + 1] = drop[first + 2] = 1;
+        drop[other] = drop[other + 1] = drop[other + 2] = 1;
+    }
+    remove_surfaces(scene_, drop);
+    triangles_.clear();
+}
+
 Scene ImportReader::finish() {
+    join_triangle_pairs();
     number_surface_names(scene_);
     scene_.input_files = state_.files();
     return std::move(scene_);

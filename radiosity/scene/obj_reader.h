@@ -4,9 +4,11 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <iosfwd>
 #include <string>
 #include <unordered_map>
+#include <utility>
 #include <vector>
 
 #include "radiosity/scene/line_reader.h"
@@ -90,9 +92,20 @@ protected:
     /// The scene read, its surfaces named uniquely (number_surface_names) and the files opened
     /// recorded (Scene::input_files).
     Scene finish();
+    /// Records that surfaces [first, first + 3) are the three quads face_to_quads made of the
+    /// triangle `corners` (in the face's turn), so that finish() may join it with a neighbour
+    /// of the same material and name into one quad (pair_triangles, faces_to_quads.h).
+    void record_triangle(size_t first, const std::array<Vec3, 3>& corners);
 
     LoadState& state_;
     Scene scene_;
+
+private:
+    /// Joins the recorded triangles in pairs (docs/scene-format.md, "Triangle pairs"): the
+    /// first triangle's first quad becomes the pair's quad, the pair's other five go.
+    void join_triangle_pairs();
+
+    std::vector<std::pair<size_t, std::array<Vec3, 3>>> triangles_;  // (first surface, corners)
 };
 
 /// Reads OBJ text named `name` as part of the load `state` (parse_obj with a shared state),

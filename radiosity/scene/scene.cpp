@@ -66,6 +66,16 @@ int surface_order(const Scene& scene, int surface) {
     return surface_order(scene, surface, scene.settings.order);
 }
 
+void remove_surfaces(Scene& scene, const std::vector<char>& drop) {
+    size_t kept = 0;
+    for (size_t i = 0; i < scene.surfaces.size(); ++i)
+        if (!drop[i]) {
+            if (kept != i) scene.surfaces[kept] = std::move(scene.surfaces[i]);
+            ++kept;
+        }
+    scene.surfaces.resize(kept);
+}
+
 void Scene::warn(const SceneWarning& w) {
     for (SceneWarning& x : warnings)
         if (x.kind == w.kind) {

@@ -129,4 +129,8 @@ int surface_order(const Scene& scene, int surface, int global_order);
 /// The same with the scene's `set order` (SolverSettings::order) as the global order.
 int surface_order(const Scene& scene, int surface);
 
+/// Removes the surfaces whose entry of `drop` (one per surface) is non-zero; the others keep
+/// their order.
+void remove_surfaces(Scene& scene, const std::vector<char>& drop);
+
 }  // namespace mbr
