@@ -174,6 +174,20 @@ TEST_CASE("obj_import: every defect is repaired with one warning per kind; stric
     }
 }
 
+TEST_CASE("obj_import: a textured quad written as two triangles stays six quads", "[obj]") {
+    // Each quad shows the image over its own (u, v) square: joining the halves would change the
+    // picture, so triangles of a textured material are not joined (docs/scene-format.md).
+    TempFolder dir;
+    dir.write("t.tga", tga_green_white());
+    dir.write("m.mtl",
+              "newmtl tiles\nKd 0.5 0.5 0.5\nmap_Kd t.tga\nnewmtl plain\nKd 0.5 0.5 0.5\n");
+    const std::string halves = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3\nf 1 3 4\n";
+    CHECK(load_obj(dir.write("t.obj", "mtllib m.mtl\nusemtl tiles\n" + halves)).surfaces.size() ==
+          6);
+    CHECK(load_obj(dir.write("p.obj", "mtllib m.mtl\nusemtl plain\n" + halves)).surfaces.size() ==
+          1);
+}
+
 TEST_CASE("obj_import: texture coordinates (vt) place the image on each face", "[obj][forgiving]") {
     TempFolder dir;
     dir.write("t.tga", tga_green_white());

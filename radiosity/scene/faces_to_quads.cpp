@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <map>
 
 namespace mbr {
 
@@ -315,9 +314,13 @@ double largest_angle(const Quad& q) {
     return largest * 180 / M_PI;
 }
 
-/// A directed edge by its ends' exact coordinates, as a map key.
-using EdgeKey = std::array<double, 6>;
-EdgeKey edge_key(Vec3 from, Vec3 to) {
+/// A directed edge by its ends' exact coordinates, and the triangle and corner it starts at.
+struct Edge {
+    std::array<double, 6> key;
+    int triangle = 0, corner = 0;
+    bool operator<(const Edge& o) const { return key < o.key; }
+};
+std::array<double, 6> edge_key(Vec3 from, Vec3 to) {
     return {from.x, from.y, from.z, to.x, to.y, to.z};
 }
 
@@ -328,13 +331,15 @@ TrianglePairs pair_triangles(const std::vector<Triangle>& triangles) {
     TrianglePairs pairs;
     pairs.partner.assign(size_t(n), -1);
     pairs.quad.resize(size_t(n));
-    // Each directed edge to the triangles (and their corner index) that walk it.
-    std::map<EdgeKey, std::vector<std::pair<int, int>>> edges;
+    // Every directed edge, sorted by its ends (a triangle's edge k runs from corner k to k + 1).
+    std::vector<Edge> edges;
+    edges.reserve(3 * size_t(n));
     for (int t = 0; t < n; ++t)
         for (int k = 0; k < 3; ++k) {
             const auto& c = triangles[size_t(t)].corner;
-            edges[edge_key(c[size_t(k)], c[size_t((k + 1) % 3)])].push_back({t, k});
+            edges.push_back({edge_key(c[size_t(k)], c[size_t((k + 1) % 3)]), t, k});
         }
+    std::stable_sort(edges.begin(), edges.end());
     for (int t = 0; t < n; ++t) {
         if (pairs.partner[size_t(t)] >= 0) continue;
         const Triangle& a = triangles[size_t(t)];
@@ -344,9 +349,10 @@ TrianglePairs pair_triangles(const std::vector<Triangle>& triangles) {
         for (int k = 0; k < 3; ++k) {
             // Edge k runs from corner k to corner k + 1; a partner walks it back.
             const Vec3 from = a.corner[size_t(k)], to = a.corner[size_t((k + 1) % 3)];
-            const auto it = edges.find(edge_key(to, from));
-            if (it == edges.end()) continue;
-            for (const auto& [u, j] : it->second) {
+            const auto [begin, end] =
+                std::equal_range(edges.begin(), edges.end(), Edge{edge_key(to, from)});
+            for (auto e = begin; e != end; ++e) {
+                const int u = e->triangle, j = e->corner;
                 if (u <= t || pairs.partner[size_t(u)] >= 0) continue;
                 const Triangle& b = triangles[size_t(u)];
                 if (b.group != a.group) continue;

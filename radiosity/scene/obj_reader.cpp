@@ -624,13 +624,19 @@ void ImportReader::record_triangle(size_t first, const std::array<Vec3, 3>& corn
 
 void ImportReader::join_triangle_pairs() {
     if (triangles_.empty()) return;
-    // Groups: one per (material, name) of the triangles' first quads.
+    // Groups: one per (material, name) of the triangles' first quads. A textured material's
+    // triangles stay apart (each quad shows its image over its own (u, v) square, or through
+    // its own copy of the material), each in a group of its own.
     std::map<std::pair<int, std::string>, int> groups;
     std::vector<Triangle> triangles;
     for (const auto& [first, corners] : triangles_) {
         const SceneSurface& s = scene_.surfaces[first];
+        const Material& m = scene_.materials[size_t(s.material)];
+        const bool textured = !m.reflectance.is_constant() || !m.emission.is_constant();
         const int group =
-            groups.emplace(std::make_pair(s.material, s.name), int(groups.size())).first->second;
+            textured ? -1 - int(triangles.size())
+                     : groups.emplace(std::make_pair(s.material, s.name), int(groups.size()))
+                           .first->second;
         triangles.push_back({corners, group});
     }
     const TrianglePairs pairs = pair_triangles(triangles);
