@@ -162,6 +162,11 @@ TEST_CASE("mgf: a quad written as two triangles is one surface (MGF and OBJ)", "
     // A cube's face of two triangles, repeated as the quad itself: the repeat is found.
     const Scene again = mgf(std::string(square_vertices) + "f a b c\nf a c d\nf b c d a\n");
     CHECK(again.surfaces.size() == 1);
+    // --keep-triangles: each half stays three quads.
+    std::istringstream kept_text(std::string(square_vertices) + "f a b c\nf a c d\n");
+    ImportOptions keep;
+    keep.join_triangles = false;
+    CHECK(parse_mgf(kept_text, "t.mgf", keep).surfaces.size() == 6);
     std::istringstream obj("v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3\nf 1 3 4\n");
     const Scene o = parse_obj(obj, "t.obj");
     REQUIRE(o.surfaces.size() == 1);

@@ -32,6 +32,8 @@ std::string solver_options_usage() {
            "  --strict                  refuse every fault of an imported OBJ, MTL, MGF or "
            "texture\n"
            "                            (default: repair it where the intent is clear, warn)\n"
+           "  --keep-triangles          every imported triangle stays three quads (default: two\n"
+           "                            triangles that make a planar quad join into one surface)\n"
            "  --light NAME[=E]          make material NAME, or the surfaces NAME and NAME.K,\n"
            "                            emit E (one number, or R,G,B; default: a mean radiosity\n"
            "                            of about 1 in the scene): for files without Ke\n"
@@ -94,6 +96,7 @@ SolverArgs read_solver_args(Args& args, SceneRun& run) {
     run.progress = std::make_shared<ProgressReporter>(!run.quiet);
     a.memory_budget = read_memory_budget(args);
     a.import.strict = args.flag("--strict");
+    a.import.join_triangles = !args.flag("--keep-triangles");
     a.light = args.text("--light", "");
     a.two_sided_lights = args.flag("--two-sided-lights");
     if (args.has("--light") && a.light.empty())

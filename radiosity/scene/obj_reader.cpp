@@ -623,7 +623,7 @@ void ImportReader::record_triangle(size_t first, const std::array<Vec3, 3>& corn
 }
 
 void ImportReader::join_triangle_pairs() {
-    if (triangles_.empty()) return;
+    if (triangles_.empty() || !state_.options().join_triangles) return;
     // Groups: one per (material, name) of the triangles' first quads. A textured material's
     // triangles stay apart (each quad shows its image over its own (u, v) square, or through
     // its own copy of the material), each in a group of its own.

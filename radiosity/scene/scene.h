@@ -71,6 +71,10 @@ struct SceneWarning {
 /// mbr's own scene format is always read strictly.
 struct ImportOptions {
     bool strict = false;
+    /// Triangles that make a planar quad with a neighbour of the same material and name become
+    /// that one quad (docs/scene-format.md, "Triangle pairs"); false keeps every triangle as
+    /// three quads, as written (`--keep-triangles`).
+    bool join_triangles = true;
 };
 
 /// A pinhole camera. A right-handed frame: the image's right is (look_at - eye) x up.
