@@ -267,9 +267,8 @@ void drop_duplicate_surfaces(Scene& scene, const ImportOptions& options) {
                                  "so remove one of them");
     std::vector<char> drop(scene.surfaces.size(), 0);
     for (int i : other_material) drop[size_t(i)] = 1;
-    const auto drop_marked = [&] { remove_surfaces(scene, drop); };
     if (repeats.empty()) {
-        drop_marked();
+        remove_surfaces(scene, drop);
         return;
     }
     // One instance per repeated statement: a statement that makes several surfaces (a box, an
@@ -302,7 +301,7 @@ void drop_duplicate_surfaces(Scene& scene, const ImportOptions& options) {
                     " (the first " + name_of(first.earlier) + ")" + same +
                     "; the repeats are dropped";
     for (const DuplicateSurface& d : repeats) drop[size_t(d.later)] = 1;
-    drop_marked();
+    remove_surfaces(scene, drop);
     scene.warn(w);
 }
 

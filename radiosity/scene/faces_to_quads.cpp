@@ -344,7 +344,7 @@ TrianglePairs pair_triangles(const std::vector<Triangle>& triangles) {
         if (pairs.partner[size_t(t)] >= 0) continue;
         const Triangle& a = triangles[size_t(t)];
         int best = -1;
-        double best_angle = max_pair_angle;
+        double best_angle = 0;
         Quad best_quad{};
         for (int k = 0; k < 3; ++k) {
             // Edge k runs from corner k to corner k + 1; a partner walks it back.
@@ -361,7 +361,8 @@ TrianglePairs pair_triangles(const std::vector<Triangle>& triangles) {
                 const Quad q{a.corner[size_t((k + 2) % 3)], from, third, to};
                 if (!planar_quad_problem(q).empty()) continue;
                 const double angle = largest_angle(q);
-                if (angle <= best_angle && (best < 0 || angle < best_angle)) {
+                if (angle > max_pair_angle) continue;
+                if (best < 0 || angle < best_angle) {
                     best = u;
                     best_angle = angle;
                     best_quad = q;

@@ -629,8 +629,7 @@ private:
                       std::to_string(max_face_vertices) + " are accepted");
         if (world().mirrors()) std::reverse(p.begin(), p.end());  // the same side stays in front
         const std::vector<Quad> quads = face_to_quads(line, p);
-        if (p.size() == 3 && quads.size() == 3)
-            record_triangle(scene_.surfaces.size(), {p[0], p[1], p[2]});
+        record_face(scene_.surfaces.size(), p, quads.size());
         for (const Quad& q : quads) add(line, Surface::planar_quad(q[0], q[1], q[2], q[3]));
     }
 

@@ -329,8 +329,7 @@ private:
             fit = std::make_unique<FaceCoordinates>(p, uv);
             coordinates = fit.get();
         }
-        if (p.size() == 3 && quads.size() == 3)
-            record_triangle(scene_.surfaces.size(), {p[0], p[1], p[2]});
+        record_face(scene_.surfaces.size(), p, quads.size());
         for (size_t k = 0; k < quads.size(); ++k) {
             const Quad& q = quads[k];
             SceneSurface s;
@@ -618,8 +617,9 @@ void ImportReader::fault(const Line& line, const std::string& kind, const std::s
     warn(kind, line.file, line.number, message + "; " + then);
 }
 
-void ImportReader::record_triangle(size_t first, const std::array<Vec3, 3>& corners) {
-    triangles_.push_back({first, corners});
+void ImportReader::record_face(size_t first, const std::vector<Vec3>& corners, size_t n_quads) {
+    if (corners.size() == 3 && n_quads == 3)
+        triangles_.push_back({first, {corners[0], corners[1], corners[2]}});
 }
 
 void ImportReader::join_triangle_pairs() {

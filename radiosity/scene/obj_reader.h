@@ -92,10 +92,11 @@ protected:
     /// The scene read, its surfaces named uniquely (number_surface_names) and the files opened
     /// recorded (Scene::input_files).
     Scene finish();
-    /// Records that surfaces [first, first + 3) are the three quads face_to_quads made of the
-    /// triangle `corners` (in the face's turn), so that finish() may join it with a neighbour
-    /// of the same material and name into one quad (pair_triangles, faces_to_quads.h).
-    void record_triangle(size_t first, const std::array<Vec3, 3>& corners);
+    /// Called with each face's corners (in the face's turn) and the number of quads
+    /// face_to_quads made of it, added from surface `first` on: a triangle's three quads are
+    /// recorded, so that finish() may join it with a neighbour of the same material and name
+    /// into one quad (pair_triangles, faces_to_quads.h).
+    void record_face(size_t first, const std::vector<Vec3>& corners, size_t n_quads);
 
     LoadState& state_;
     Scene scene_;
