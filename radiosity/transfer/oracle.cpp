@@ -28,7 +28,9 @@ struct Oracle {
     std::vector<double> lagrange;  // [p * m + a]: the m-point interpolant at the rule_c nodes
     double scale = 0;              // the largest root sample (0 when the bounds decide alone)
     int min_depth = 0;             // the weak receiver rule may lower options' min_depth
-    const ShooterPlane* contact_plane = nullptr;  // a planar shooter, when the contact rule asks
+    // The planar shooters (a cluster's parts), when the contact rule asks; empty when a part is
+    // not planar.
+    std::vector<const ShooterPlane*> contact_planes{};
     bool contact_test = false;  // the contact oracle differs from the oracle's test
 };
 
@@ -272,11 +274,13 @@ OracleAction oracle_action(const Oracle& o, const DyadicCell& cell, long* evals,
     const ReceiverOptions& opt = o.opt;
     if (cell.level < o.min_depth) return OracleAction::Split;
     // Whether the cell touches the shooter, asked only when an answer matters.
-    const bool ask = o.contact_plane && (cell.level < opt.contact_depth ||
-                                         (o.contact_test && cell.level < opt.max_depth));
-    const double nearness =
-        ask ? nearness_to_shooter(*o.sampler.receiver().surface, *o.contact_plane, cell.rect())
-            : HUGE_VAL;
+    const bool ask = !o.contact_planes.empty() && (cell.level < opt.contact_depth ||
+                                                   (o.contact_test && cell.level < opt.max_depth));
+    double nearness = HUGE_VAL;  // a cluster's nearest part
+    if (ask)
+        for (const ShooterPlane* plane : o.contact_planes)
+            nearness = std::min(
+                nearness, nearness_to_shooter(*o.sampler.receiver().surface, *plane, cell.rect()));
     const bool contact = nearness <= contact_split_reach;
     if (cell.level < opt.contact_depth && contact) return OracleAction::Split;
     if (cell.level >= opt.max_depth) return OracleAction::Leaf;
@@ -285,9 +289,10 @@ OracleAction oracle_action(const Oracle& o, const DyadicCell& cell, long* evals,
         return OracleAction::Split;
     if (opt.thin_rim > 0 && holds_thin_rim(o.sampler.receiver(), cell.rect(), opt.thin_rim))
         return OracleAction::Split;
-    if (o.contact_plane && opt.contact_depth > 0 &&
-        hovers_at_outline(*o.sampler.receiver().surface, *o.contact_plane, cell.rect()))
-        return OracleAction::Split;
+    if (opt.contact_depth > 0)
+        for (const ShooterPlane* plane : o.contact_planes)
+            if (hovers_at_outline(*o.sampler.receiver().surface, *plane, cell.rect()))
+                return OracleAction::Split;
     const int th = thread_index();
     // DESIGN: a cell touching the shooter takes contact_oracle_test (`set contact_oracle`):
     // there dB grows like d log d. Only a cell within contact_test_reach of it: at half its
@@ -324,18 +329,25 @@ void subdivide_by_oracle(ReceiverState& state, IncrementSampler& sampler) {
         stats.n_oracle_increments += increments;
         // The weak transfer rule (weak_transfer.h): below the threshold, with the shooter far
         // enough for these samples to stand for the receiver, the root stays the only leaf.
-        if (is_weak_transfer(opt, o.scale) &&
-            root_samples_represent(*sampler.shooter().surface, *sampler.receiver().surface)) {
+        bool represent = true;  // for every part of a cluster
+        for (int part = 0; part < sampler.n_parts(); ++part)
+            represent = represent && root_samples_represent(*sampler.shooter(part).surface,
+                                                            *sampler.receiver().surface);
+        if (is_weak_transfer(opt, o.scale) && represent) {
             stats.weak = true;
             store_leaf_samples(state, forest.domain_root(), root.data());
             return;
         }
     }
     o.min_depth = weak_receiver_min_depth(opt, o.scale);
-    // The shooter's plane when it is planar (the contact rule).
+    // The shooter's plane when it is planar (the contact rule); a cluster's every part's.
     o.contact_test = opt.contact_oracle_test != opt.oracle_test;
-    if (opt.contact_depth > 0 || o.contact_test)
-        o.contact_plane = sampler.integrator(0).shooter_plane();
+    if (opt.contact_depth > 0 || o.contact_test) {
+        for (int part = 0; part < sampler.n_parts(); ++part)
+            o.contact_planes.push_back(sampler.integrator(0, part).shooter_plane());
+        if (std::count(o.contact_planes.begin(), o.contact_planes.end(), nullptr) > 0)
+            o.contact_planes.clear();
+    }
 
     std::vector<int> frontier{forest.domain_root()};
     while (!frontier.empty()) {

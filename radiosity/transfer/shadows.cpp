@@ -112,25 +112,20 @@ bool shaft_clear(Vec3 p, const Vec3 (&q)[4], const std::vector<Box3>& boxes) {
     return true;
 }
 
-/// Eq. (28) at the domain point (s, t), computed (no memo): rays to random points of the
-/// patches of the shooter partition (IncrementIntegrator::fraction_partition), weighed by the
-/// energy each sends to the point.
-Rgb compute_fraction(const ReceiverState& state, IncrementSampler& sampler, Vec2 point,
-                     double inset, int thread, long* n_rays, long* n_evals) {
-    const OcclusionContext& ctx = *state.occlusion;
-    // DESIGN: a point of the domain's boundary is moved `inset` inside (boundary_inset of the
-    // finest leaf, as edgefill does): on an edge shared with the shooter the kernel is singular.
-    const double s = std::clamp(point.x, inset, 1 - inset),
-                 t = std::clamp(point.y, inset, 1 - inset);
-    // DESIGN: a hidden point's fraction is that of the nearest visible point, whose sample of
-    // (21) it already takes (radiosity/visibility/hidden_regions.h): its own would be 0 and cut
-    // the continuous extension back to a step (a ceiling behind a hanging lamp read 3.5 % dark
-    // for 0.2 m around the lamp's outline).
-    const ReceiverSurface& receiver = sampler.receiver();
-    const Vec2 at = receiver.hidden ? receiver.hidden->substitute(s, t) : Vec2{s, t};
-    const SurfacePoint p = receiver.surface->evaluate(at.x, at.y);
-    IncrementIntegrator& integrator = sampler.integrator(thread);
-    const Surface& shooter = *sampler.shooter().surface;
+/// What one shooter sends to a point in (28): num / den is its visible fraction. `clear`: no
+/// occluder meets the point's pyramid to the shooter (the fraction is 1; num and den are not
+/// computed).
+struct FractionSums {
+    Rgb num, den;
+    bool clear = false;
+};
+
+/// Eq. (28) for one shooter at the receiving point p (the domain point `point`): rays to random
+/// points of the patches of the shooter partition (IncrementIntegrator::fraction_partition),
+/// weighed by the energy each sends to the point.
+FractionSums shooter_fraction(const ReceiverState& state, const OcclusionContext& ctx,
+                              IncrementIntegrator& integrator, const Surface& shooter,
+                              const SurfacePoint& p, Vec2 point, long* n_rays, long* n_evals) {
     // DESIGN: beyond the paper, the rays of a point are tested only against the occluders that
     // meet its pyramid to a planar shooter; when there are none the fraction is 1 without a ray
     // (what the rays would give, to the bit) and without the partition's kernel evaluations.
@@ -154,7 +149,7 @@ Rgb compute_fraction(const ReceiverState& state, IncrementSampler& sampler, Vec2
                 grown_boxes.push_back(ctx.segment_boxes[k]);
                 near_count += ctx.surface_box_counts[k];
             }
-        if (near_boxes.empty()) return {1, 1, 1};
+        if (near_boxes.empty()) return {{}, {}, true};
         // DESIGN: the octree's walk for the occluders that meet the pyramid (occluders_toward)
         // stops beyond max_listed_occluders; then the rays go through the octree, so the list
         // need not be complete. When the boxes met (at most max_near_boxes of them) hold more
@@ -167,7 +162,7 @@ Rgb compute_fraction(const ReceiverState& state, IncrementSampler& sampler, Vec2
         // candidates block on either: segment_blocked).
         const bool walk = many_boxes || near_count <= walk_candidates;
         toward = occluders_toward(ctx, *plane, p.position, walk ? max_listed_occluders : 0);
-        if (toward.empty()) return {1, 1, 1};
+        if (toward.empty()) return {{}, {}, true};
         listed = walk && toward.size() <= max_listed_occluders;
     }
     // A segment from p to the shooter, tested against toward when it lists every occluder,
@@ -273,6 +268,51 @@ Rgb compute_fraction(const ReceiverState& state, IncrementSampler& sampler, Vec2
                 num[ch] += rays.weight[i] * visible[ch] / weight[ch] * e[ch];
                 den[ch] += e[ch];
             }
+    }
+    return {num, den, false};
+}
+
+/// Eq. (28) at the domain point (s, t), computed (no memo). A planar cluster's parts each give
+/// their visible share of what they send, and the fraction is the sum of the visible energies
+/// over the sum of all (a part nothing occludes sends its integral I(p) whole).
+Rgb compute_fraction(const ReceiverState& state, IncrementSampler& sampler, Vec2 point,
+                     double inset, int thread, long* n_rays, long* n_evals) {
+    // DESIGN: a point of the domain's boundary is moved `inset` inside (boundary_inset of the
+    // finest leaf, as edgefill does): on an edge shared with the shooter the kernel is singular.
+    const double s = std::clamp(point.x, inset, 1 - inset),
+                 t = std::clamp(point.y, inset, 1 - inset);
+    // DESIGN: a hidden point's fraction is that of the nearest visible point, whose sample of
+    // (21) it already takes (radiosity/visibility/hidden_regions.h): its own would be 0 and cut
+    // the continuous extension back to a step (a ceiling behind a hanging lamp read 3.5 % dark
+    // for 0.2 m around the lamp's outline).
+    const ReceiverSurface& receiver = sampler.receiver();
+    const Vec2 at = receiver.hidden ? receiver.hidden->substitute(s, t) : Vec2{s, t};
+    const SurfacePoint p = receiver.surface->evaluate(at.x, at.y);
+    Rgb num, den;
+    if (sampler.n_parts() == 1) {
+        const FractionSums one =
+            shooter_fraction(state, *state.occlusion, sampler.integrator(thread),
+                             *sampler.shooter().surface, p, point, n_rays, n_evals);
+        if (one.clear) return {1, 1, 1};
+        num = one.num;
+        den = one.den;
+    } else {
+        for (int part = 0; part < sampler.n_parts(); ++part) {
+            IncrementIntegrator& integrator = sampler.integrator(thread, part);
+            const OcclusionContext* ctx = sampler.part_occlusion(part);
+            FractionSums sums;
+            sums.clear = ctx == nullptr;
+            if (ctx)
+                sums = shooter_fraction(state, *ctx, integrator, *sampler.shooter(part).surface, p,
+                                        point, n_rays, n_evals);
+            if (sums.clear) {
+                const IncrementIntegrator::Result r = integrator.integrate(p);
+                if (n_evals) *n_evals += r.n_evaluations;
+                sums.num = sums.den = r.value;
+            }
+            num += sums.num;
+            den += sums.den;
+        }
     }
     Rgb f;
     for (int c = 0; c < 3; ++c) f[c] = den[c] > 0 ? std::clamp(num[c] / den[c], 0.0, 1.0) : 1.0;

@@ -61,6 +61,14 @@ SplineField transfer(const Shooter& shooter, const ReceiverSurface& receiver,
                      const ReceiverOptions& options, TransferStats* stats_out,
                      ReceiverState* keep_state, const OcclusionContext* occlusion,
                      const DualTable* dual) {
+    return transfer({ShooterPart{&shooter, occlusion}}, receiver, options, stats_out, keep_state,
+                    dual);
+}
+
+SplineField transfer(const std::vector<ShooterPart>& given_parts, const ReceiverSurface& receiver,
+                     const ReceiverOptions& options, TransferStats* stats_out,
+                     ReceiverState* keep_state, const DualTable* dual) {
+    MBR_CHECK(!given_parts.empty());
     MBR_CHECK_MSG(options.m >= 2 && options.m <= 8, "order m = " << options.m);
     MBR_CHECK(options.min_depth >= 0 && options.min_depth <= options.max_depth &&
               options.max_depth <= 14);
@@ -77,11 +85,20 @@ SplineField transfer(const Shooter& shooter, const ReceiverSurface& receiver,
         }
         const DualTable& dn = *dual;
         // A pair that nothing can come between casts no rays and projects nothing.
-        state = ReceiverState(options, rhombus_radius_cells(options, dn),
-                              (occlusion && !occlusion->clear()) ? occlusion : nullptr);
+        std::vector<ShooterPart> parts = given_parts;
+        const OcclusionContext* occlusion = nullptr;  // the first part's occluders, if any
+        for (ShooterPart& part : parts) {
+            if (part.occlusion && part.occlusion->clear()) part.occlusion = nullptr;
+            if (!occlusion) occlusion = part.occlusion;
+        }
+        state = ReceiverState(options, rhombus_radius_cells(options, dn), occlusion);
         const ShadowMethod shadows = state.occlusion ? options.shadows.method : ShadowMethod::None;
-        IncrementSampler sampler(shooter, receiver, options.quadrature,
-                                 shadows == ShadowMethod::Exact ? state.occlusion : nullptr);
+        IncrementSampler sampler =
+            parts.size() == 1
+                ? IncrementSampler(*parts[0].shooter, receiver, options.quadrature,
+                                   shadows == ShadowMethod::Exact ? state.occlusion : nullptr)
+                : IncrementSampler(parts, receiver, options.quadrature,
+                                   shadows == ShadowMethod::Exact);
         // With unify_by_projection the expanded domain is not built: project_fine_grid
         // evaluates the extrapolation (23)-(27) at the nodes it needs.
         const bool fine_grid = options.unify_by_projection;

@@ -60,6 +60,14 @@ SplineField transfer(const Shooter& shooter, const ReceiverSurface& receiver,
                      ReceiverState* keep_state = nullptr,
                      const OcclusionContext* occlusion = nullptr, const DualTable* dual = nullptr);
 
+/// The same for shooters whose fields add up (a planar cluster's members, each with its pair's
+/// occluders; ShooterPart): one receiver tree, one fit and one projection for the sum (the
+/// oracle's contact rule asks every part's plane). options.shadows.method says how every part's
+/// occluders enter.
+SplineField transfer(const std::vector<ShooterPart>& parts, const ReceiverSurface& receiver,
+                     const ReceiverOptions& options, TransferStats* stats = nullptr,
+                     ReceiverState* keep_state = nullptr, const DualTable* dual = nullptr);
+
 /// The shooter as section 6 uses it: its unshot field coarsened by `levels` (not below 0).
 Shooter make_shooter(const Surface& surface, const SplineField& unshot, int levels);
 
