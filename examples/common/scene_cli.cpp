@@ -412,7 +412,7 @@ Solution solve_scene(SceneRun& run, bool progress) {
             if (!in_shot) shot_stage();
             sp.done = done;
             sp.total = total;
-            std::snprintf(text, sizeof text, "%d/%d receivers", done, total);
+            std::snprintf(text, sizeof text, "%d/%d transfers", done, total);
             reporter->update(text, sp.fraction(), sp.seconds_left(now_seconds()));
         });
     if (reporter) reporter->stage("");
@@ -431,14 +431,15 @@ double percent_of_emitted(double power, const SolveStats& stats) {
 
 void print_shots(std::ostream& os, const Scene& scene, const SolveStats& stats) {
     Table t({"shot", "shooter", "shooter_power", "unshot_before_percent", "unshot_after_percent",
-             "receivers", "kernel_evals", "analytic_evals", "rays", "level", "seconds"});
+             "receivers", "kernel_evals", "analytic_evals", "rays", "level", "seconds", "members"});
     for (const ShotStats& s : stats.per_shot)
-        t.add_row(
-            {std::to_string(s.shot), scene.surfaces[s.shooter].name, cell_g(s.shooter_power, 4),
-             cell_g(percent_of_emitted(s.unshot_before, stats), 4),
-             cell_g(percent_of_emitted(s.unshot_after, stats), 4), std::to_string(s.receivers),
-             std::to_string(s.kernel_evals), std::to_string(s.analytic_evals),
-             std::to_string(s.rays), std::to_string(s.finest_level), cell(s.seconds, 3)});
+        t.add_row({std::to_string(s.shot), scene.surfaces[s.shooter].name,
+                   cell_g(s.shooter_power, 4),
+                   cell_g(percent_of_emitted(s.unshot_before, stats), 4),
+                   cell_g(percent_of_emitted(s.unshot_after, stats), 4),
+                   std::to_string(s.receivers), std::to_string(s.kernel_evals),
+                   std::to_string(s.analytic_evals), std::to_string(s.rays),
+                   std::to_string(s.finest_level), cell(s.seconds, 3), std::to_string(s.members)});
     t.write_text(os);
 }
 
@@ -477,6 +478,10 @@ void print_summary(std::ostream& os, const SceneRun& run, const SolveStats& st) 
         os << "weak transfers: " << st.weak_transfers << " of " << st.transfers
            << " (every root sample below " << cell_g(run.options.receiver.weak_transfer, 3)
            << " tolerances) took the polynomial through their root's samples\n";
+    if (st.clustered_shots > 0)
+        os << "planar clusters: " << st.clustered_shots << " of " << st.shots
+           << " shots were of coplanar surfaces together (" << st.clustered_surfaces
+           << " surfaces in them)\n";
     if (run.options.ambient && st.ambient_power > 0)
         os << "ambient correction: " << cell_g(percent_of_emitted(st.ambient_power, st), 4)
            << " % of the emitted power added"

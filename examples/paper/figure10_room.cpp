@@ -49,10 +49,10 @@ std::string usage() {
 void print_shot(std::ostream& os, const Scene& scene, const ShotStats& s, double emitted) {
     char line[200];
     std::snprintf(line, sizeof line,
-                  "%5d  %-14s  %10.4g  %12.4g%%  %11.4g%%  %4d  %12ld  %10ld  %2d  %9.3f\n", s.shot,
-                  scene.surfaces[s.shooter].name.c_str(), s.shooter_power,
+                  "%5d  %-14s  %10.4g  %12.4g%%  %11.4g%%  %4d  %12ld  %10ld  %2d  %9.3f  %7d\n",
+                  s.shot, scene.surfaces[s.shooter].name.c_str(), s.shooter_power,
                   100 * s.unshot_before / emitted, 100 * s.unshot_after / emitted, s.receivers,
-                  s.kernel_evals, s.rays, s.finest_level, s.seconds);
+                  s.kernel_evals, s.rays, s.finest_level, s.seconds, s.members);
     os << line << std::flush;
 }
 
@@ -102,7 +102,7 @@ int run(Args& args) {
                   << " shots, convergence " << run.options.convergence << "\n";
         if (per_shot)
             std::cout << " shot  shooter         shooter_pw  unshot_before  unshot_after  recv  "
-                         "kernel_evals        rays  lv    seconds\n";
+                         "kernel_evals        rays  lv    seconds  members\n";
         std::cout << std::flush;
     }
     const Solution solution =

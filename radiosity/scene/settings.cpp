@@ -116,6 +116,11 @@ std::vector<OptionSpec> make_option_table() {
         switch_option("self_transfer", &S::self_transfer,
                       "a surface that can see itself (an inward cylinder or sphere patch) receives "
                       "from itself; planar surfaces never do"),
+        switch_option("cluster_shots", &S::cluster_shots,
+                      "beyond the paper: the surfaces next to the shooter in its plane, facing "
+                      "its way, with at least a tenth of its unshot power shoot with it (a "
+                      "planar cluster); a receiver farther than the cluster's diagonal takes one "
+                      "transfer of their sum"),
         integer_option("tessellation", &S::tessellation, 1, 1024, "T",
                        "facets per curved parameter direction when rays are cast at curved "
                        "surfaces (at least 3 along an angle; one along a cylinder's height or a "

@@ -66,6 +66,8 @@ struct SolverSettings {
     int max_shots = 100;        // cap on progressive shots
     double convergence = 1e-3;  // stop when the largest unshot power < this x emitted
     bool self_transfer = true;  // a surface that can see itself (concave curved) lights itself
+    bool cluster_shots = false;  // coplanar neighbours with a share of the shooter's unshot
+                                 //   power shoot with it (a planar cluster)
     int tessellation = 16;      // facets per parameter direction for ray casting
     ShadowSetting shadows = ShadowSetting::Auto;
     double tolerance = 2e-3;  // accuracy relative to the scene's radiosity scale

@@ -101,6 +101,43 @@ bool behind(const Surface& planar, const Surface& other) {
     return front_reach(planar, other, &tolerance) <= tolerance;
 }
 
+/// Whether planar surface b lies in planar surface a's plane and faces its way (the planar
+/// cluster's test, planar_cluster).
+bool coplanar_alike(const Surface& a, const Surface& b) {
+    if (!a.is_planar() || !b.is_planar() || a.is_concave() || b.is_concave()) return false;
+    if (dot(a.normal(0.5, 0.5), b.normal(0.5, 0.5)) < 1 - 1e-9) return false;
+    double tolerance = 0;
+    if (front_reach(a, b, &tolerance) > tolerance) return false;
+    const Vec3 n = a.normal(0.5, 0.5), o = a.point(0.5, 0.5);
+    for (const Vec3& q : hull_points(b))
+        if (dot(n, q - o) < -tolerance) return false;
+    return true;
+}
+
+/// The least distance between two boxes (0 when they meet).
+double box_distance(const Box3& a, const Box3& b) {
+    const Vec3 gap = max(max(a.lo - b.hi, b.lo - a.hi), Vec3{0, 0, 0});
+    return length(gap);
+}
+
+/// The counts of a second transfer to the same receiver (a planar cluster's parts that took the
+/// other shadow method) added to the first's.
+void add_counts(TransferStats& a, const TransferStats& b) {
+    a.n_kernel_evals += b.n_kernel_evals;
+    a.n_analytic_evals += b.n_analytic_evals;
+    a.n_increments += b.n_increments;
+    a.n_oracle_increments += b.n_oracle_increments;
+    a.n_boundary_increments += b.n_boundary_increments;
+    a.n_unconverged += b.n_unconverged;
+    a.n_leaves += b.n_leaves;
+    a.n_rays += b.n_rays;
+    a.n_fractions += b.n_fractions;
+    a.n_shadow_splits += b.n_shadow_splits;
+    a.weak = a.weak && b.weak;
+    a.level = std::max(a.level, b.level);
+    a.seconds_total += b.seconds_total;
+}
+
 std::uint64_t cell_key(const DyadicCell& c) {
     return (std::uint64_t(c.level) << 56) | (std::uint64_t(std::uint32_t(c.i)) << 28) |
            std::uint64_t(std::uint32_t(c.j));
@@ -132,6 +169,55 @@ std::vector<NearContact> near_contacts(const Scene& scene) {
             }
         }
     return found;
+}
+
+std::vector<int> planar_cluster(const Scene& scene, int h, const std::vector<double>& unshot) {
+    const Surface& lead = scene.surfaces[size_t(h)].surface;
+    if (!lead.is_planar() || lead.is_concave() || !(unshot[size_t(h)] > 0)) return {h};
+    std::vector<int> candidates;
+    for (int j = 0; j < int(scene.surfaces.size()); ++j)
+        if (j != h && unshot[size_t(j)] > 0 &&
+            unshot[size_t(j)] >= cluster_share * unshot[size_t(h)] &&
+            coplanar_alike(lead, scene.surfaces[size_t(j)].surface))
+            candidates.push_back(j);
+    // Grown from h: a candidate joins when its box comes within cluster_reach of the smaller
+    // diagonal of a member's box (the pieces of one floor, the tubes of one luminaire; not the
+    // lamps of a whole ceiling, whose every sample would integrate over all of them).
+    std::vector<Box3> boxes{lead.bounds()};
+    Box3 all = lead.bounds();  // the cluster's, kept within cluster_extent of the lead's size
+    const double largest = cluster_extent * length(all.extent());
+    std::vector<int> others;
+    std::vector<bool> joined(candidates.size(), false);
+    for (bool grew = true; grew && int(others.size()) < max_cluster_members - 1;) {
+        grew = false;
+        for (size_t c = 0; c < candidates.size(); ++c) {
+            if (joined[c]) continue;
+            const Box3 b = scene.surfaces[size_t(candidates[c])].surface.bounds();
+            for (size_t k = 0; k < boxes.size() && !joined[c]; ++k) {
+                const double reach =
+                    cluster_reach * std::min(length(b.extent()), length(boxes[k].extent()));
+                Box3 grown = boxes[k];
+                grown.lo = grown.lo - Vec3{reach, reach, reach};
+                grown.hi = grown.hi + Vec3{reach, reach, reach};
+                joined[c] = overlaps(grown, b);
+            }
+            if (joined[c]) {
+                Box3 with = all;
+                with.extend(b);
+                joined[c] = length(with.extent()) <= largest;
+            }
+            if (!joined[c]) continue;
+            all.extend(b);
+            boxes.push_back(b);
+            others.push_back(candidates[c]);
+            grew = true;
+            if (int(others.size()) == max_cluster_members - 1) break;
+        }
+    }
+    std::sort(others.begin(), others.end());
+    std::vector<int> members{h};
+    members.insert(members.end(), others.begin(), others.end());
+    return members;
 }
 
 namespace {
@@ -219,6 +305,7 @@ SolverOptions solver_options(const SolverSettings& s) {
     o.max_shots = s.max_shots;
     o.convergence = s.convergence;
     o.self_transfer = s.self_transfer;
+    o.cluster_shots = s.cluster_shots;
     o.tolerance = s.tolerance;
     o.ambient = s.ambient;
     o.ambient_rays = s.ambient_rays;
@@ -640,6 +727,24 @@ std::vector<int> ProgressiveSolver::receivers_of(int h) const {
     return receivers;
 }
 
+std::vector<int> ProgressiveSolver::receivers_of(const std::vector<int>& members) const {
+    if (members.size() == 1) return receivers_of(members[0]);
+    std::vector<int> receivers;
+    for (int h : members) {
+        const std::vector<int> r = receivers_of(h);
+        receivers.insert(receivers.end(), r.begin(), r.end());
+    }
+    std::sort(receivers.begin(), receivers.end());
+    receivers.erase(std::unique(receivers.begin(), receivers.end()), receivers.end());
+    // The members lie in one plane: none receives from another.
+    receivers.erase(
+        std::remove_if(
+            receivers.begin(), receivers.end(),
+            [&](int i) { return std::find(members.begin(), members.end(), i) != members.end(); }),
+        receivers.end());
+    return receivers;
+}
+
 OcclusionContext ProgressiveSolver::occlusion_of(int h, int i, int shot) const {
     // Without shadows no ray is cast: the pair needs its ids and seed, no candidates (their
     // search took 76 % of the time of a sphere in 20 pieces).
@@ -680,25 +785,48 @@ OcclusionContext ProgressiveSolver::occlusion_of(int h, int i, int shot) const {
 }
 
 std::vector<ProgressiveSolver::Received> ProgressiveSolver::transfer_to(
-    const std::vector<int>& receivers, int h, const Shooter& shooter, const ReceiverOptions& ro,
-    int shot_number) {
+    const std::vector<int>& receivers, const std::vector<int>& members,
+    const std::vector<Shooter>& shooters, const ReceiverOptions& ro, int shot_number) {
     const int n_rec = static_cast<int>(receivers.size());
     std::vector<Received> results(receivers.size());
-    std::vector<OcclusionContext> contexts(receivers.size());
-    parallel_for(n_rec,
-                 [&](int k) { contexts[size_t(k)] = occlusion_of(h, receivers[k], shot_number); });
-    for (int k = 0; k < n_rec; ++k) {  // keep new pairs' candidates, within the bound
-        const OcclusionContext& c = contexts[size_t(k)];
-        const size_t size =
-            c.candidates.size() + 25 * c.surface_boxes.size();  // in ints: two boxes and a count
-        if (options_.receiver.shadows.method == ShadowMethod::None ||
-            candidates_.count({h, receivers[k]}) ||
-            cached_candidates_ + size > max_cached_candidates)
-            continue;
-        cached_candidates_ += size;
-        candidates_[{h, receivers[k]}] = contexts[size_t(k)];
-    }
-    auto run_transfer = [&](int k) {
+    // Per receiver the members that face it (one shooter: itself), and their pairs' occluders.
+    std::vector<std::vector<int>> faced(receivers.size());
+    std::vector<std::vector<OcclusionContext>> contexts(receivers.size());
+    parallel_for(n_rec, [&](int k) {
+        const int i = receivers[k];
+        const Surface& r = scene_.surfaces[size_t(i)].surface;
+        for (int j = 0; j < int(members.size()); ++j) {
+            const Surface& h = scene_.surfaces[size_t(members[j])].surface;
+            if (members.size() > 1 && (behind(h, r) || behind(r, h))) continue;
+            faced[size_t(k)].push_back(j);
+            contexts[size_t(k)].push_back(occlusion_of(members[j], i, shot_number));
+        }
+    });
+    for (int k = 0; k < n_rec; ++k)  // keep new pairs' candidates, within the bound
+        for (size_t p = 0; p < faced[size_t(k)].size(); ++p) {
+            const int h = members[size_t(faced[size_t(k)][p])];
+            const OcclusionContext& c = contexts[size_t(k)][p];
+            const size_t size =
+                c.candidates.size() + 25 * c.surface_boxes.size();  // in ints: two boxes, a count
+            if (options_.receiver.shadows.method == ShadowMethod::None ||
+                candidates_.count({h, receivers[k]}) ||
+                cached_candidates_ + size > max_cached_candidates)
+                continue;
+            cached_candidates_ += size;
+            candidates_[{h, receivers[k]}] = c;
+        }
+    Box3 cluster_box;  // the members' bounds together
+    for (int h : members) cluster_box.extend(scene_.surfaces[size_t(h)].surface.bounds());
+    // Each receiver's options and surface, then its transfers (jobs).
+    std::vector<ReceiverOptions> options(receivers.size(), ro);
+    std::vector<ReceiverSurface> surfaces(receivers.size());
+    struct Job {
+        int k = 0;  // the receiver
+        std::vector<ShooterPart> parts;
+        bool paper = false;
+    };
+    std::vector<Job> jobs;
+    for (int k = 0; k < n_rec; ++k) {
         const int i = receivers[k];
         const Texture& rho = scene_.material_of(i).reflectance;
         const bool irradiance = solution_.quantity[i] == FieldQuantity::irradiance;
@@ -708,16 +836,16 @@ std::vector<ProgressiveSolver::Received> ProgressiveSolver::transfer_to(
         // H has no texture steps to force splits, and the paper's two means agree on a smooth
         // H long before the spline follows it (a checker plate under a square light: 1.8 % at
         // the square centres with the means, 0.29 % with the fit; docs/method.md).
-        ReceiverOptions options = ro;
-        options.m = order_[i];  // the receiver's basis
+        ReceiverOptions& o = options[size_t(k)];
+        o.m = order_[i];  // the receiver's basis
         if (irradiance) {
             const double largest = max_abs(rho.maximum());
-            options.absolute_tolerance /= largest;
-            options.quadrature.abs_tolerance /= largest;
-            options.oracle_test = OracleTest::Interpolation;
-            options.contact_oracle_test = OracleTest::Interpolation;
+            o.absolute_tolerance /= largest;
+            o.quadrature.abs_tolerance /= largest;
+            o.oracle_test = OracleTest::Interpolation;
+            o.contact_oracle_test = OracleTest::Interpolation;
         }
-        const ReceiverSurface receiver{
+        surfaces[size_t(k)] = ReceiverSurface{
             &scene_.surfaces[i].surface,
             irradiance ? std::function<Rgb(double, double)>([](double, double) {
                 return Rgb{1, 1, 1};
@@ -725,31 +853,54 @@ std::vector<ProgressiveSolver::Received> ProgressiveSolver::transfer_to(
                        : std::function<Rgb(double, double)>(
                              [&rho](double s, double t) { return rho.value(s, t); }),
             hidden_[i].any() ? &hidden_[i] : nullptr};
-        const OcclusionContext& occlusion = contexts[size_t(k)];
-        if (options_.exact_shadow_casters > 0 && options.shadows.method == ShadowMethod::Exact &&
-            shadow_casters(occlusion) > options_.exact_shadow_casters &&
-            !projects_at_samples(occlusion, *shooter.surface, scene_.surfaces[i].surface)) {
-            options.shadows.method = ShadowMethod::Fractions;
-            results[k].paper = true;
+        // Under shadows auto each pair chooses its method. A receiver at least cluster_far
+        // diagonals from a planar cluster takes one transfer of the parts that chose alike (at
+        // most two: exact visibility, the paper's fractions); a nearer one a transfer per part,
+        // as from shots of their own. The transfers' fields add up.
+        const bool far = members.size() > 1 &&
+                         box_distance(cluster_box, scene_.surfaces[size_t(i)].surface.bounds()) >=
+                             cluster_far * length(cluster_box.extent());
+        const size_t first_job = jobs.size();
+        for (size_t p = 0; p < faced[size_t(k)].size(); ++p) {
+            const Shooter& shooter = shooters[size_t(faced[size_t(k)][p])];
+            const OcclusionContext& occlusion = contexts[size_t(k)][p];
+            const bool paper =
+                options_.exact_shadow_casters > 0 && o.shadows.method == ShadowMethod::Exact &&
+                shadow_casters(occlusion) > options_.exact_shadow_casters &&
+                !projects_at_samples(occlusion, *shooter.surface, scene_.surfaces[i].surface);
+            const auto alike = std::find_if(jobs.begin() + long(first_job), jobs.end(),
+                                            [&](const Job& g) { return g.paper == paper; });
+            if (far && alike != jobs.end())
+                alike->parts.push_back({&shooter, &occlusion});
+            else
+                jobs.push_back({k, {{&shooter, &occlusion}}, paper});
         }
+    }
+    const int n_jobs = static_cast<int>(jobs.size());
+    std::vector<Received> done(jobs.size());
+    auto run_transfer = [&](int j) {
+        const Job& job = jobs[size_t(j)];
+        ReceiverOptions job_options = options[size_t(job.k)];
+        if (job.paper) job_options.shadows.method = ShadowMethod::Fractions;
         ReceiverState state;
-        results[k].field = transfer(shooter, receiver, options, &results[k].stats, &state,
-                                    &occlusion, duals_[size_t(options.m)].get());
+        Received& r = done[size_t(j)];
+        r.paper = job.paper;
+        r.field = transfer(job.parts, surfaces[size_t(job.k)], job_options, &r.stats, &state,
+                           duals_[size_t(job_options.m)].get());
         for (int index = 0; index < state.forest.n_nodes(); ++index) {
             const Forest::Node& node = state.forest.node(index);
-            if (!node.is_leaf() && node.cell.in_domain())
-                results[k].splits.push_back(cell_key(node.cell));
+            if (!node.is_leaf() && node.cell.in_domain()) r.splits.push_back(cell_key(node.cell));
         }
     };
     std::mutex progress_mutex;  // on_transfer_'s calls, one at a time
     int n_done = 0;
-    auto run_one = [&](int k) {
-        run_transfer(k);
+    auto run_one = [&](int j) {
+        run_transfer(j);
         if (!on_transfer_) return;
         std::lock_guard<std::mutex> lock(progress_mutex);
-        on_transfer_(++n_done, n_rec);
+        on_transfer_(++n_done, n_jobs);
     };
-    if (n_rec == 1) {
+    if (n_jobs == 1) {
         run_one(0);  // parallel inside
     } else {
         // The receivers that took longest last time first, so that no thread is left with one
@@ -757,27 +908,58 @@ std::vector<ProgressiveSolver::Received> ProgressiveSolver::transfer_to(
         // the paper's fractions are seeded by their points, not by threads, and running the
         // room's transfers side by side instead of each one's fractions in parallel took its
         // 2-thread wall time from 20.7 to 17.5 s (farm-bench, 3 runs each), the same output.
-        std::vector<int> order(n_rec);
-        for (int k = 0; k < n_rec; ++k) order[k] = k;
+        std::vector<int> order(n_jobs);
+        for (int j = 0; j < n_jobs; ++j) order[j] = j;
         std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
-            return last_seconds_[receivers[a]] > last_seconds_[receivers[b]];
+            return last_seconds_[receivers[jobs[size_t(a)].k]] >
+                   last_seconds_[receivers[jobs[size_t(b)].k]];
         });
-        parallel_for(n_rec, [&](int k) { run_one(order[k]); });
+        parallel_for(n_jobs, [&](int j) { run_one(order[j]); });
+    }
+    // Each receiver's transfers in job order: the first's field and counts, the others added.
+    for (int j = 0; j < n_jobs; ++j) {
+        Received& result = results[size_t(jobs[size_t(j)].k)];
+        Received& r = done[size_t(j)];
+        result.paper = result.paper || r.paper;
+        if (result.field.empty()) {
+            result.field = std::move(r.field);
+            result.stats = r.stats;
+        } else {
+            result.field.add(r.field);
+            add_counts(result.stats, r.stats);
+        }
+        result.splits.insert(result.splits.end(), r.splits.begin(), r.splits.end());
     }
     for (int k = 0; k < n_rec; ++k) last_seconds_[receivers[k]] = results[k].stats.seconds_total;
     return results;
 }
 
 void ProgressiveSolver::superpose(const std::vector<int>& receivers, std::vector<Received>& results,
-                                  int h, const Shooter& shooter, ShotStats& shot) {
+                                  const std::vector<int>& members,
+                                  const std::vector<Shooter>& shooters, ShotStats& shot) {
     const int n = static_cast<int>(scene_.surfaces.size());
     const int n_rec = static_cast<int>(receivers.size());
-    const Rgb shot_power = power(h, shooter.unshot);
-    std::vector<Rgb>& row = coupling_[h];
-    if (row.empty()) row.assign(n, Rgb{});
-    shot_power_[h] += shot_power;
+    const int h = members[0];
+    // Each member's power, and its share of the shot's (a cluster's coupling is shared so).
+    std::vector<Rgb> member_power(members.size());
+    Rgb total_power;
+    for (size_t j = 0; j < members.size(); ++j) {
+        member_power[j] = power(members[j], shooters[j].unshot);
+        total_power += member_power[j];
+        std::vector<Rgb>& row = coupling_[size_t(members[j])];
+        if (row.empty()) row.assign(n, Rgb{});
+        shot_power_[size_t(members[j])] += member_power[j];
+    }
+    std::vector<Rgb> member_share(members.size(), Rgb{1, 1, 1});
+    if (members.size() > 1)
+        for (size_t j = 0; j < members.size(); ++j)
+            for (int c = 0; c < 3; ++c)
+                member_share[j][c] = total_power[c] > 0 ? member_power[j][c] / total_power[c] : 0;
     std::vector<SplineField> unshot_increments(n_rec);  // dB_i of the irradiance receivers
-    const Rgb shooter_bound = coefficient_bound(shooter.unshot);  // >= max B_h
+    Rgb shooter_bound;  // >= max B_h over the members (a sum of their kernels' shares of it)
+    for (const Shooter& shooter : shooters)
+        for (int c = 0; c < 3; ++c)
+            shooter_bound[c] = std::max(shooter_bound[c], coefficient_bound(shooter.unshot)[c]);
     // What each receiver adds to the shot's sums, added in the receivers' order afterwards.
     struct Part {
         double limited = 0;
@@ -832,7 +1014,8 @@ void ProgressiveSolver::superpose(const std::vector<int>& receivers, std::vector
             if (rv[c] > 0) {
                 const double incident = irradiance ? part.arrived[c] : part.reflected[c] / rv[c];
                 shot.incident += incident;
-                row[i][c] += incident;
+                for (size_t j = 0; j < members.size(); ++j)
+                    coupling_[size_t(members[j])][size_t(i)][c] += member_share[j][c] * incident;
             }
         shot.kernel_evals += r.stats.n_kernel_evals;
         shot.analytic_evals += r.stats.n_analytic_evals;
@@ -841,6 +1024,9 @@ void ProgressiveSolver::superpose(const std::vector<int>& receivers, std::vector
         shot.weak_transfers += r.stats.weak ? 1 : 0;
         shot.finest_level = std::max(shot.finest_level, r.field.level());
     }
+    for (size_t j = 1; j < members.size(); ++j)  // a cluster's other members (all planar)
+        solution_.unshot[size_t(members[j])] =
+            SplineField::constant(order_[size_t(members[j])], 0, {0, 0, 0});
     const Surface& shooter_surface = scene_.surfaces[h].surface;
     if (!(options_.self_transfer && shooter_surface.is_concave() &&
           std::find(receivers.begin(), receivers.end(), h) != receivers.end())) {
@@ -870,9 +1056,14 @@ ShotStats ProgressiveSolver::shoot() {
     }
     const int h = shot.shooter;
     shot.shooter_power = unshot[h];
+    // Beyond the paper: the surfaces in h's plane with a share of its power shoot with it.
+    const std::vector<int> members =
+        options_.cluster_shots ? planar_cluster(scene_, h, unshot) : std::vector<int>{h};
+    shot.members = static_cast<int>(members.size());
+    for (size_t j = 1; j < members.size(); ++j) shot.shooter_power += unshot[size_t(members[j])];
 
-    // The receivers: every surface that can see the shooter's front and be seen by it.
-    const std::vector<int> receivers = receivers_of(h);
+    // The receivers: every surface that can see a shooter's front and be seen by it.
+    const std::vector<int> receivers = receivers_of(members);
     shot.receivers = static_cast<int>(receivers.size());
 
     // Tolerances against the scene's scale (cost follows energy).
@@ -882,12 +1073,16 @@ ShotStats ProgressiveSolver::shoot() {
     // Shadow splits follow power (shadows.cpp, worth_splitting): against a finest cell of the
     // scene's largest surface.
     ro.shadows.split_area = largest_area_ * std::pow(0.25, ro.max_depth);
-    const SplineField& unshot_h = solution_.unshot[h];
-    const int coarsen = std::max(ro.shooter_coarsening, unshot_h.level() - options_.shooter_level);
-    const Shooter shooter = make_shooter(scene_.surfaces[h].surface, unshot_h, coarsen);
+    std::vector<Shooter> shooters;
+    for (int j : members) {
+        const SplineField& unshot_j = solution_.unshot[size_t(j)];
+        const int coarsen =
+            std::max(ro.shooter_coarsening, unshot_j.level() - options_.shooter_level);
+        shooters.push_back(make_shooter(scene_.surfaces[size_t(j)].surface, unshot_j, coarsen));
+    }
 
-    std::vector<Received> results = transfer_to(receivers, h, shooter, ro, shot.shot);
-    superpose(receivers, results, h, shooter, shot);
+    std::vector<Received> results = transfer_to(receivers, members, shooters, ro, shot.shot);
+    superpose(receivers, results, members, shooters, shot);
     for (int i = 0; i < n; ++i) shot.unshot_after += unshot_power(i);
     shot.seconds = now() - start;
 
@@ -900,6 +1095,10 @@ ShotStats ProgressiveSolver::shoot() {
     st.transfers += shot.receivers;
     st.paper_transfers += shot.paper_transfers;
     st.weak_transfers += shot.weak_transfers;
+    if (shot.members > 1) {
+        ++st.clustered_shots;
+        st.clustered_surfaces += shot.members;
+    }
     st.limited_power += shot.limited;
     st.per_shot.push_back(shot);
     return shot;

@@ -46,6 +46,8 @@ struct SolverOptions {
     int max_shots = 100;        // stop after this many shots
     double convergence = 1e-3;  // stop when the largest unshot power < this x emitted
     bool self_transfer = true;  // concave curved surfaces receive from themselves
+    bool cluster_shots = false;  // beyond the paper: a planar cluster shoots in one shot
+                                 //   (planar_cluster, cluster_far)
     double tolerance = 2e-3;    // accuracy relative to the scene's radiosity scale: the
                                 //   absolute tolerance of every transfer (see file comment)
     /// The quadrature's absolute tolerance, as a share of the transfer's (a constant).
@@ -95,11 +97,46 @@ struct NearContact {
 /// found before solving so that programs can warn about them.
 std::vector<NearContact> near_contacts(const Scene& scene);
 
+/// A planar cluster (beyond the paper; issue 21's shooter clusters in their simplest form): the
+/// planar surfaces that lie in the shooter's plane, face its way, hold at least cluster_share
+/// of its unshot power and lie next to it or to another member (planar_cluster) shoot with it in
+/// one shot. They cannot see one another, so they receive nothing from each other, and every
+/// receiver takes one transfer of their summed fields (transfer() with several ShooterParts):
+/// one tree, one fit and one projection for the pieces of a floor or the tubes of a luminaire,
+/// instead of one per piece. DESIGN: a tenth.
+constexpr double cluster_share = 0.1;
+/// Next to: a member's bounding box grown by this share of the smaller of the two boxes'
+/// diagonals meets the other's. DESIGN: a quarter (lamps spread over a ceiling stay apart: each
+/// sample of a cluster's transfers integrates over every member, and corridor.mgf's 57 lamps in
+/// clusters of up to 64 took twice its time).
+constexpr double cluster_reach = 0.25;
+/// A planar cluster's bounds stay within this many times the lead's diagonal: the pieces of one
+/// face (the three quads of a triangle, a floor's pieces around a block), not a whole floor of
+/// tiles, whose near receivers would each take a transfer from every tile in one shot (the
+/// classroom's third shot had 30,711 transfers with clusters of up to 64 members). DESIGN: 2.
+constexpr double cluster_extent = 2;
+/// A receiver at least this many of a planar cluster's diagonals (of the members' bounds
+/// together) away takes one transfer of their sum; a nearer one takes a transfer from each member
+/// on its own, as if each shot alone (the members' shares of a near receiver differ in shape, and
+/// every sample of one transfer would integrate over all of them). DESIGN: 1.
+constexpr double cluster_far = 1;
+/// At most this many surfaces in one planar cluster. DESIGN.
+constexpr int max_cluster_members = 64;
+
+/// The planar cluster of shooter h (h first, then the others in index order), given every
+/// surface's unshot power; {h} when h is not planar. Coplanar: normals within 1e-9 of each other
+/// and every hull point within the `behind` test's plane tolerance of h's plane. Grown from h by
+/// cluster_reach within cluster_extent; beyond max_cluster_members the candidates met first (in
+/// index order) stay.
+std::vector<int> planar_cluster(const Scene& scene, int h, const std::vector<double>& unshot);
+
 /// One shot of the loop, measured.
 struct ShotStats {
     int shot = 0;              // 1, 2, ...
     int shooter = -1;          // surface index
-    double shooter_power = 0;  // its unshot power int B_unshot A (sum of channels) before
+    int members = 1;           // surfaces that shot (a planar cluster: the shooter and others)
+    double shooter_power = 0;  // its unshot power int B_unshot A (sum of channels) before (a
+                               //   planar cluster's: its members' together)
     double unshot_before = 0;  // the scene's total unshot power before the shot
     double unshot_after = 0;   //   and after
     double reflected = 0;      // power the receivers reflect: sum_i int dB_i A
@@ -130,6 +167,8 @@ struct SolveStats {
     long transfers = 0;          // of all shots (ShotStats::receivers)
     long paper_transfers = 0;    //   of which with the paper's fractions under shadows auto
     long weak_transfers = 0;     //   of which weak transfers (ShotStats::weak_transfers)
+    long clustered_shots = 0;    // shots of planar clusters (ShotStats::members > 1)
+    long clustered_surfaces = 0;  //   and the surfaces that shot in them
     double ambient_power = 0;    // power the ambient correction added (sum of channels)
     long ambient_rays = 0;       //   and the rays its gather cast
     double ambient_seconds = 0;  //   and the gather's wall time
@@ -252,16 +291,21 @@ private:
     /// The surfaces that receive from shooter h: every other surface that reflects and faces h
     /// (front to front), and h itself when it is concave and self_transfer is on.
     std::vector<int> receivers_of(int h) const;
-    /// One transfer per receiver (section 5), in parallel over receivers or one at a time with
-    /// parallel stages (the paper's shadows); the results do not depend on the order.
-    std::vector<Received> transfer_to(const std::vector<int>& receivers, int h,
-                                      const Shooter& shooter, const ReceiverOptions& options,
-                                      int shot_number);
+    /// The same for the members of a planar cluster (h first): the union of their receivers.
+    std::vector<int> receivers_of(const std::vector<int>& members) const;
+    /// One transfer per receiver (section 5) from the members that face it (all of them for
+    /// one shooter), in parallel over receivers; the results do not depend on the order.
+    std::vector<Received> transfer_to(const std::vector<int>& receivers,
+                                      const std::vector<int>& members,
+                                      const std::vector<Shooter>& shooters,
+                                      const ReceiverOptions& options, int shot_number);
     /// Superposition in receiver order: B_i += dB_i, B_unshot_i += dB_i, the measured coupling
-    /// of h to each receiver and the cells split, then B_unshot_h = 0 (or what h received from
-    /// itself). Fills the shot's power and count fields.
-    void superpose(const std::vector<int>& receivers, std::vector<Received>& results, int h,
-                   const Shooter& shooter, ShotStats& shot);
+    /// of the members to each receiver (a cluster's shared in proportion to the members'
+    /// power) and the cells split, then every member's B_unshot = 0 (or what a concave shooter
+    /// received from itself). Fills the shot's power and count fields.
+    void superpose(const std::vector<int>& receivers, std::vector<Received>& results,
+                   const std::vector<int>& members, const std::vector<Shooter>& shooters,
+                   ShotStats& shot);
 };
 
 /// Solves the scene: shots until done(), calling on_shot (may be empty) after each.
