@@ -120,8 +120,8 @@ double box_distance(const Box3& a, const Box3& b) {
     return length(gap);
 }
 
-/// The counts of a second transfer to the same receiver (a planar cluster's parts that took the
-/// other shadow method) added to the first's.
+/// The counts of another transfer to the same receiver in one shot (a planar cluster's: from
+/// another member, or from the members that took the other shadow method) added to the first's.
 void add_counts(TransferStats& a, const TransferStats& b) {
     a.n_kernel_evals += b.n_kernel_evals;
     a.n_analytic_evals += b.n_analytic_evals;
@@ -845,13 +845,14 @@ std::vector<ProgressiveSolver::Received> ProgressiveSolver::transfer_to(
             o.oracle_test = OracleTest::Interpolation;
             o.contact_oracle_test = OracleTest::Interpolation;
         }
+        // The reflectance is read after this loop: the lambda keeps the scene's texture.
         surfaces[size_t(k)] = ReceiverSurface{
             &scene_.surfaces[i].surface,
             irradiance ? std::function<Rgb(double, double)>([](double, double) {
                 return Rgb{1, 1, 1};
             })
                        : std::function<Rgb(double, double)>(
-                             [&rho](double s, double t) { return rho.value(s, t); }),
+                             [tex = &rho](double s, double t) { return tex->value(s, t); }),
             hidden_[i].any() ? &hidden_[i] : nullptr};
         // Under shadows auto each pair chooses its method. A receiver at least cluster_far
         // diagonals from a planar cluster takes one transfer of the parts that chose alike (at
