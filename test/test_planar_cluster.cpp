@@ -1,6 +1,7 @@
 // test/test_planar_cluster.cpp - planar clusters (beyond the paper; radiosity/solver/solver.h,
-// planar_cluster): coplanar surfaces that face alike shoot together, and every receiver takes one
-// transfer of their summed fields (transfer() with several ShooterParts).
+// planar_cluster): coplanar neighbours that face alike shoot together; a receiver at least the
+// cluster's diagonal away takes one transfer of their summed fields (transfer() with several
+// ShooterParts), a nearer one a transfer from each.
 //
 // Independent references: the same light as one surface (a lamp whole against the lamp in
 // pieces), the sum of the members' own transfers, and the power balance of a closed box.

@@ -100,20 +100,23 @@ std::vector<NearContact> near_contacts(const Scene& scene);
 /// A planar cluster (beyond the paper; issue 21's shooter clusters in their simplest form): the
 /// planar surfaces that lie in the shooter's plane, face its way, hold at least cluster_share
 /// of its unshot power and lie next to it or to another member (planar_cluster) shoot with it in
-/// one shot. They cannot see one another, so they receive nothing from each other, and every
-/// receiver takes one transfer of their summed fields (transfer() with several ShooterParts):
-/// one tree, one fit and one projection for the pieces of a floor or the tubes of a luminaire,
-/// instead of one per piece. DESIGN: a tenth.
+/// one shot. They cannot see one another, so they receive nothing from each other, and a
+/// receiver cluster_far away takes one transfer of their summed fields (transfer() with several
+/// ShooterParts): one tree, one fit and one projection for the pieces of a floor or the tubes
+/// of a luminaire, instead of one per piece. DESIGN: a tenth.
 constexpr double cluster_share = 0.1;
 /// Next to: a member's bounding box grown by this share of the smaller of the two boxes'
 /// diagonals meets the other's. DESIGN: a quarter (lamps spread over a ceiling stay apart: each
-/// sample of a cluster's transfers integrates over every member, and corridor.mgf's 57 lamps in
-/// clusters of up to 64 took twice its time).
+/// sample of a cluster's transfers integrates over every member, and with every coplanar
+/// surface joining, and every receiver taking one transfer of the sum, corridor.mgf took twice
+/// its time).
 constexpr double cluster_reach = 0.25;
 /// A planar cluster's bounds stay within this many times the lead's diagonal: the pieces of one
 /// face (the three quads of a triangle, a floor's pieces around a block), not a whole floor of
-/// tiles, whose near receivers would each take a transfer from every tile in one shot (the
-/// classroom's third shot had 30,711 transfers with clusters of up to 64 members). DESIGN: 2.
+/// tiles, whose near receivers would each take a transfer from every tile in one shot (without
+/// it the classroom's third shot had 30,711 transfers; with it its 25th still had 27,248, a
+/// large piece with many small ones beside it, where a shot without clusters has about 5,000).
+/// DESIGN: 2.
 constexpr double cluster_extent = 2;
 /// A receiver at least this many of a planar cluster's diagonals (of the members' bounds
 /// together) away takes one transfer of their sum; a nearer one takes a transfer from each member
