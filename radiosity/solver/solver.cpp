@@ -958,9 +958,10 @@ void ProgressiveSolver::superpose(const std::vector<int>& receivers, std::vector
                 member_share[j][c] = total_power[c] > 0 ? member_power[j][c] / total_power[c] : 0;
     std::vector<SplineField> unshot_increments(n_rec);  // dB_i of the irradiance receivers
     Rgb shooter_bound;  // >= max B_h over the members (a sum of their kernels' shares of it)
-    for (const Shooter& shooter : shooters)
-        for (int c = 0; c < 3; ++c)
-            shooter_bound[c] = std::max(shooter_bound[c], coefficient_bound(shooter.unshot)[c]);
+    for (const Shooter& shooter : shooters) {
+        const Rgb bound = coefficient_bound(shooter.unshot);
+        for (int c = 0; c < 3; ++c) shooter_bound[c] = std::max(shooter_bound[c], bound[c]);
+    }
     // What each receiver adds to the shot's sums, added in the receivers' order afterwards.
     struct Part {
         double limited = 0;

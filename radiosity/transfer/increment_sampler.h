@@ -44,8 +44,8 @@ public:
     /// The shooters whose integrals add up (1: the paper's single shooter).
     int n_parts() const { return static_cast<int>(parts_.size()); }
     const Shooter& shooter(int part = 0) const { return *parts_[size_t(part)].shooter; }
-    /// A part's occluders as the parts constructor named them (null: none, or the one-shooter
-    /// constructor, whose caller keeps them: ReceiverState::occlusion).
+    /// A part's occluders (null: none). The one-shooter constructor names only exact
+    /// visibility's; for the paper's fractions its caller keeps them (ReceiverState::occlusion).
     const OcclusionContext* part_occlusion(int part) const {
         return parts_[size_t(part)].occlusion;
     }

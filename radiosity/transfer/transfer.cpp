@@ -93,12 +93,8 @@ SplineField transfer(const std::vector<ShooterPart>& given_parts, const Receiver
         }
         state = ReceiverState(options, rhombus_radius_cells(options, dn), occlusion);
         const ShadowMethod shadows = state.occlusion ? options.shadows.method : ShadowMethod::None;
-        IncrementSampler sampler =
-            parts.size() == 1
-                ? IncrementSampler(*parts[0].shooter, receiver, options.quadrature,
-                                   shadows == ShadowMethod::Exact ? state.occlusion : nullptr)
-                : IncrementSampler(parts, receiver, options.quadrature,
-                                   shadows == ShadowMethod::Exact);
+        IncrementSampler sampler(parts, receiver, options.quadrature,
+                                 shadows == ShadowMethod::Exact);
         // With unify_by_projection the expanded domain is not built: project_fine_grid
         // evaluates the extrapolation (23)-(27) at the nodes it needs.
         const bool fine_grid = options.unify_by_projection;
