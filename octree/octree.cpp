@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 
 #include "math/check.h"
 
@@ -174,12 +175,6 @@ Box3 Octree::child_cube(const Box3& cube, int i) {
     return c;
 }
 
-// Ray records numbered as the build's leaves first list their polygons.
-struct Octree::Numbering {
-    std::vector<int> record_of;  // polygon index -> record number, -1 until listed
-    int n_records = 0;
-};
-
 // The state of one ray query, all on the caller's stack (queries are thread-safe).
 struct Octree::Query {
     Ray ray;                     // closest hit: t_max shrinks to the best hit found so far
@@ -309,11 +304,10 @@ struct Octree::ChildHits {
     }
 };
 
-Octree::ChildHits Octree::child_hits(const Block& block, unsigned mask, const Query& q) const {
+Octree::ChildHits Octree::child_hits(const Box3& cube, unsigned mask, const Query& q) const {
     // The faces of the grown children along each axis: the lower child spans [lo, mid_hi], the
     // upper one [mid_lo, hi] (grown(child_cube(cube, i)) component by component). Six slabs
     // serve the eight children.
-    const Box3& cube = block.cube;
     const Vec3 m{margin_, margin_, margin_};
     const Vec3 mid = cube.centre();
     const Vec3 lo = cube.lo - m, mid_lo = mid - m, mid_hi = mid + m, hi = cube.hi + m;
@@ -378,28 +372,22 @@ Octree::Octree(std::vector<Polygon> polygons, Options options)
     margin_ = 1e-7 * side + 2 * slack;
     grown_root_ = grown(root_cube_);
 
+    make_records();
+    std::vector<ListEntry> entry_of(polygons_.size());
+    for (int id = 0; id < polygon_count(); ++id) entry_of[size_t(id)] = list_entry(id);
     std::vector<int> ids(polygons_.size());
     for (int i = 0; i < static_cast<int>(ids.size()); ++i) ids[i] = i;
-    Numbering numbering;
-    numbering.record_of.assign(polygons_.size(), -1);
-    root_ = build(root_cube_, std::move(ids), 0, numbering);
+    root_ = build(root_cube_, std::move(ids), 0, entry_of);
     has_root_ = true;
-    make_records(numbering);
     prefetch_ = double(records_.size()) * sizeof(RayRecord) > options_.prefetch_bytes;
 }
 
-// The ray records in the order of `numbering` (a polygon no leaf lists, which the node test
-// never allows, would get one at the end), and the leaves' lists turned from polygon indices
-// into record numbers.
-void Octree::make_records(Numbering& numbering) {
-    std::vector<int>& record_of = numbering.record_of;
-    for (int& r : record_of)
-        if (r < 0) r = numbering.n_records++;
+// The ray records, one for each polygon, in the polygons' order.
+void Octree::make_records() {
     records_.resize(polygons_.size());
-    record_polygon_.resize(polygons_.size());
     for (int id = 0; id < polygon_count(); ++id) {
         const Polygon& p = polygons_[id];
-        RayRecord& r = records_[record_of[id]];
+        RayRecord& r = records_[size_t(id)];
         r.plane = p.plane();
         r.slack = p.edge_slack();
         r.polygon = id;
@@ -411,9 +399,54 @@ void Octree::make_records(Numbering& numbering) {
             std::copy(b.begin(), b.end(), r.planes.begin());
         else
             extra_planes_.insert(extra_planes_.end(), b.begin(), b.end());
-        record_polygon_[record_of[id]] = id;
     }
-    for (int& entry : leaf_records_) entry = record_of[entry];
+}
+
+namespace {
+
+// The largest float at most x, and the smallest at least x (infinite beyond the floats' range).
+float float_below(double x) {
+    if (!(x > -std::numeric_limits<float>::max())) return -std::numeric_limits<float>::infinity();
+    if (x > std::numeric_limits<float>::max()) return std::numeric_limits<float>::max();
+    const float f = static_cast<float>(x);
+    return double(f) > x ? std::nextafter(f, -std::numeric_limits<float>::infinity()) : f;
+}
+float float_above(double x) {
+    return -float_below(-x);
+}
+
+}  // namespace
+
+// Where intersect_planes can find a hit on the polygon: the computed hit point lies on the
+// polygon's plane to rounding, and within `slack` of every bounding plane, so within the
+// polygon grown by the slack, whose corners reach slack / sin(theta / 2) beyond a vertex of
+// angle theta. Grown further by the nodes' margin (which covers the plane's distance from the
+// vertices, twice the slack and the rounding of the slab tests), that is within the box below.
+// A vertex sharper than 1e-3 rad (the nodes' margin covers such a corner no further) leaves the
+// box unbounded: every ray reads the record.
+Octree::ListEntry Octree::list_entry(int id) const {
+    const Polygon& polygon = polygons_[size_t(id)];
+    const std::vector<Vec3>& v = polygon.vertices();
+    const int n = polygon.n_vertices();
+    double min_sin_half = 1;
+    for (int i = 0; i < n; ++i) {
+        const Vec3 a = normalize(v[size_t(i)] - v[size_t((i + n - 1) % n)]);
+        const Vec3 b = normalize(v[size_t((i + 1) % n)] - v[size_t(i)]);
+        // The angle theta at vertex i between the edges: cos theta = -a.b, and
+        // sin(theta / 2) = sqrt((1 - cos theta) / 2).
+        min_sin_half = std::min(min_sin_half, std::sqrt(std::max(0.0, 0.5 * (1 + dot(a, b)))));
+    }
+    ListEntry box;
+    box.polygon = id;
+    box.surface = polygon.surface();
+    const Box3 b = polygon.bounds();
+    const double reach =
+        min_sin_half >= 5e-4 ? margin_ + polygon.edge_slack() / min_sin_half : HUGE_VAL;
+    for (int k = 0; k < 3; ++k) {
+        box.lo[size_t(k)] = float_below(b.lo[k] - reach);
+        box.hi[size_t(k)] = float_above(b.hi[k] + reach);
+    }
+    return box;
 }
 
 Box3 Octree::grown(const Box3& cube) const {
@@ -422,10 +455,9 @@ Box3 Octree::grown(const Box3& cube) const {
 }
 
 // Builds the node of `cube` listing `ids` and its subtree. An internal node's block is appended
-// before its children's (depth first). A leaf's list holds polygon indices until make_records;
-// `numbering` numbers the polygons as leaves first list them.
+// before its children's (depth first); a leaf's list is the entries (entry_of) of its polygons.
 Octree::Node Octree::build(const Box3& cube, std::vector<int> ids, int depth,
-                           Numbering& numbering) {
+                           const std::vector<ListEntry>& entry_of) {
     ++node_count_;
     depth_ = std::max(depth_, depth);
     const int n_ids = static_cast<int>(ids.size());
@@ -448,13 +480,12 @@ Octree::Node Octree::build(const Box3& cube, std::vector<int> ids, int depth,
         if (0.25 * static_cast<double>(n_child_refs) + 1 < n_ids) {
             const int b = static_cast<int>(blocks_.size());
             blocks_.emplace_back();
-            blocks_[b].cube = cube;
             unsigned mask = 0;
             for (int i = 0; i < 8; ++i) {
                 if (lists[i].empty()) continue;
                 mask |= 1u << i;
                 const Node child =
-                    build(child_cube(cube, i), std::move(lists[i]), depth + 1, numbering);
+                    build(child_cube(cube, i), std::move(lists[i]), depth + 1, entry_of);
                 blocks_[b].child[i] = child;  // blocks_ may have grown: index again
             }
             return Node::internal(b, mask);
@@ -462,28 +493,24 @@ Octree::Node Octree::build(const Box3& cube, std::vector<int> ids, int depth,
     }
     ++leaf_count_;
     reference_count_ += n_ids;
-    const Node leaf = Node::leaf(static_cast<int>(leaf_records_.size()), n_ids);
-    leaf_records_.insert(leaf_records_.end(), ids.begin(), ids.end());
-    for (int id : ids)
-        if (numbering.record_of[id] < 0) numbering.record_of[id] = numbering.n_records++;
+    const Node leaf = Node::leaf(static_cast<int>(leaf_entries_.size()), n_ids);
+    for (int id : ids) leaf_entries_.push_back(entry_of[size_t(id)]);
     return leaf;
 }
 
-// Asks the memory for the three cache lines of every record a leaf lists (prefetch_).
-void Octree::prefetch_records(const Node& leaf) const {
-    for (int r = leaf.first, end = leaf.first + leaf.count(); r < end; ++r) {
-        const char* rec = reinterpret_cast<const char*>(&records_[leaf_records_[r]]);
-        __builtin_prefetch(rec);
-        __builtin_prefetch(rec + 64);
-        __builtin_prefetch(rec + 128);
-    }
+// Asks the memory for a leaf's list (its entries are read one after the other); a record is
+// read only by the rays that meet its polygon's hit box.
+void Octree::prefetch_list(const Node& leaf) const {
+    const char* first = reinterpret_cast<const char*>(&leaf_entries_[size_t(leaf.first)]);
+    const char* end = first + size_t(leaf.count()) * sizeof(ListEntry);
+    for (const char* line = first; line < end; line += 64) __builtin_prefetch(line);
 }
 
 bool Octree::test_leaf(const Node& node, Query& q) const {
-    if (prefetch_) prefetch_records(node);
+    if (prefetch_) prefetch_list(node);
     for (int r = node.first, end = node.first + node.count(); r < end; ++r) {
-        const RayRecord& p = records_[leaf_records_[r]];
-        const int id = p.polygon;
+        const ListEntry& box = leaf_entries_[size_t(r)];
+        const int id = box.polygon;
         // A polygon listed by several leaves is tested once per ray unless another polygon
         // with the same index mod 32 was tested in between; a repeated test is only wasted
         // work. Skipping is sound: t_max only shrinks, so an earlier miss stays a miss and an
@@ -491,8 +518,14 @@ bool Octree::test_leaf(const Node& node, Query& q) const {
         int& slot = q.recent[id & 31];
         if (slot == id) continue;
         slot = id;
-        if (q.filter.skips(p.surface)) continue;
+        if (q.filter.skips(box.surface)) continue;
         ++q.stats.n_polygons_tested;
+        // A ray that misses the polygon's hit box misses the polygon (list_entry): the test's
+        // answer without reading its record.
+        if (!q.meets_box(
+                Box3{{box.lo[0], box.lo[1], box.lo[2]}, {box.hi[0], box.hi[1], box.hi[2]}}))
+            continue;
+        const RayRecord& p = records_[size_t(id)];
         // Polygon::intersect's own function on the packed copy of its planes: the same t.
         std::optional<double> t =
             intersect_planes(p.plane, p.bounding(extra_planes_), p.n_planes, p.slack, q.ray);
@@ -511,6 +544,13 @@ bool Octree::test_leaf(const Node& node, Query& q) const {
         if (*t < q.ray.t_max || q.best < 0 || id < q.best) {
             q.ray.t_max = *t;
             q.best = id;
+            // The hit's (u, v) reads the polygon at the end (Polygon::uv_at): asked for now, it
+            // arrives while the walk goes on.
+            if (prefetch_) {
+                const char* poly = reinterpret_cast<const char*>(&polygons_[size_t(id)]);
+                for (size_t line = 0; line < sizeof(Polygon); line += 64)
+                    __builtin_prefetch(poly + line);
+            }
         }
     }
     return false;
@@ -518,22 +558,20 @@ bool Octree::test_leaf(const Node& node, Query& q) const {
 
 // Visits a node and, front to back, the children the ray meets. True when an any-hit query is
 // answered.
-bool Octree::traverse(const Node& node, Query& q) const {
+bool Octree::traverse(const Node& node, const Box3& cube, Query& q) const {
     ++q.stats.n_nodes_visited;
     if (node.is_leaf()) return test_leaf(node, q);
     const Block& block = blocks_[node.first];
-    const ChildHits hits = child_hits(block, node.child_mask(), q);
+    const ChildHits hits = child_hits(cube, node.child_mask(), q);
     // DESIGN (prefetch_, octree.h): every child met is asked for at once, so that their misses
-    // overlap, and below, the records of the child visited next while this one is walked.
+    // overlap, and below, the list of the child visited next while this one is walked.
     if (prefetch_)
         for (unsigned m = hits.meets; m != 0; m &= m - 1) {
             const Node& c = block.child[lowest_bit.of[m]];
             if (c.is_leaf())
-                __builtin_prefetch(&leaf_records_[c.first]);
-            else {
+                __builtin_prefetch(&leaf_entries_[size_t(c.first)]);
+            else
                 __builtin_prefetch(&blocks_[c.first]);
-                __builtin_prefetch(reinterpret_cast<const char*>(&blocks_[c.first]) + 64);
-            }
         }
     if (q.any) {
         // Any hit: t_max stays put, so every child met is visited unless a hit ends the query,
@@ -545,9 +583,10 @@ bool Octree::traverse(const Node& node, Query& q) const {
             const unsigned rest = order & (order - 1);
             if (prefetch_ && rest) {
                 const Node& next = block.child[lowest_bit.of[rest] ^ q.flip];
-                if (next.is_leaf()) prefetch_records(next);
+                if (next.is_leaf()) prefetch_list(next);
             }
-            if (traverse(block.child[lowest_bit.of[order] ^ q.flip], q)) return true;
+            const int i = lowest_bit.of[order] ^ q.flip;
+            if (traverse(block.child[i], child_cube(cube, i), q)) return true;
         }
         return false;
     }
@@ -559,8 +598,8 @@ bool Octree::traverse(const Node& node, Query& q) const {
     for (int k = 0, n = hits.sorted(q.flip, order); k < n; ++k) {
         if (hits.entry[order[k]] > q.ray.t_max) break;
         if (prefetch_ && k + 1 < n && block.child[order[k + 1]].is_leaf())
-            prefetch_records(block.child[order[k + 1]]);
-        traverse(block.child[order[k]], q);
+            prefetch_list(block.child[order[k + 1]]);
+        traverse(block.child[order[k]], child_cube(cube, order[k]), q);
     }
     return false;
 }
@@ -573,7 +612,7 @@ std::optional<Hit> Octree::closest_hit(const Ray& ray, const RayFilter& filter,
                                        RayStats* stats) const {
     if (!has_root_) return std::nullopt;
     Query q(ray, filter, false);
-    if (q.meets_box(grown_root_)) traverse(root_, q);
+    if (q.meets_box(grown_root_)) traverse(root_, root_cube_, q);
     if (stats) *stats += q.stats;
     if (q.best < 0) return std::nullopt;
     const Polygon& p = polygons_[q.best];
@@ -592,7 +631,7 @@ bool Octree::any_hit(const Ray& ray, const RayFilter& filter, RayStats* stats) c
 int Octree::any_hit_polygon(const Ray& ray, const RayFilter& filter, RayStats* stats) const {
     if (!has_root_) return -1;
     Query q(ray, filter, true);
-    const bool hit = q.meets_box(grown_root_) && traverse(root_, q);
+    const bool hit = q.meets_box(grown_root_) && traverse(root_, root_cube_, q);
     if (stats) *stats += q.stats;
     return hit ? q.best : -1;
 }

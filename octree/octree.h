@@ -18,15 +18,17 @@
 // Layout (beyond the paper, for the cache; the tree, its subdivision and every query's path
 // through it are those of the pointer octree it replaced). A node is 8 bytes: a leaf holds where
 // its list starts and its length, an internal node the index of its block and which octants have
-// a child. A block holds an internal node's cube and its eight child nodes (the pointers of the
-// paper's octree become indices), 128 bytes aligned on two cache lines; the blocks lie in one
-// array in depth-first order. Cubes are stored, not recomputed: a visit reads its node's block
-// and works out the six slabs of the children's grown cubes once. The leaves' lists are slices of
-// one array of "ray records": what the ray-polygon test reads of a polygon (its plane, bounding
-// planes, slack, surface and index) in three cache lines, numbered in the order the leaves first
-// list them, so a leaf's records lie close together. Queries keep their state on the stack.
-// When the records outgrow the cache (OctreeOptions::prefetch_bytes), queries ask the memory for
-// the children and records they will read next before reading them (prefetch_).
+// a child. A block holds an internal node's eight child nodes (the pointers of the paper's
+// octree become indices), 64 bytes on one cache line; the blocks lie in one array in depth-first
+// order. A node's cube is not stored: the query splits it from its parent's on the way down
+// (child_cube, as the build did) and works out the six slabs of the children's grown cubes once.
+// A leaf's list is a slice of one array of 32-byte entries, each a polygon's index and surface
+// and the box, in floats, that a hit on it must lie in; only a ray that meets the box reads the
+// polygon's "ray record": what the ray-polygon test reads of it (its plane, bounding planes,
+// slack, surface and index) in three cache lines. Queries keep their state on the stack. When
+// the records outgrow the cache (OctreeOptions::prefetch_bytes), queries ask the memory for the
+// children and lists they will read next before reading them, and for the polygon of a new best
+// hit (prefetch_).
 #pragma once
 
 #include <algorithm>
@@ -189,7 +191,7 @@ public:
 private:
     // A cube of the tree, 8 bytes. An internal node's children are the nodes of its block,
     // blocks_[first].child[i] for the octants i with bit i of child_mask() set; a leaf lists the
-    // ray records leaf_records_[first .. first + count()).
+    // entries leaf_entries_[first .. first + count()).
     struct Node {
         int first = 0;  // internal: index of its block; leaf: start of its list
         int code = 0;   // leaf: count() >= 0; internal: -1 - child_mask()
@@ -201,11 +203,13 @@ private:
         int count() const { return code; }
         unsigned child_mask() const { return static_cast<unsigned>(-1 - code); }
     };
-    // An internal node's cube and its eight children (slot i is octant i, unused where the node
-    // has no child there): two cache lines, all that a visit of the node reads of the tree.
-    struct alignas(128) Block {
+    // An internal node's eight children (slot i is octant i, unused where the node has no child
+    // there): one cache line, all that a visit of the node reads of the tree. Its cube is not
+    // stored: a query splits it from its parent's on the way down, as the build did, to the
+    // same values (one line a node instead of two: on 200,000 quads 1.06 times the closest-hit
+    // and 1.09 times the any-hit rays a second, docs/method.md).
+    struct alignas(64) Block {
         std::array<Node, 8> child;
-        Box3 cube;  // the internal node's cube (not grown by the margin)
     };
     // What the ray-polygon test reads of one polygon, packed: copies of Polygon's plane, slack
     // and bounding planes (inline up to four, else extra_planes_[first_extra ..]), its surface
@@ -222,17 +226,28 @@ private:
             return n_planes <= 4 ? planes.data() : extra.data() + first_extra;
         }
     };
+    // An entry of a leaf's list: the box a hit on the polygon can lie in (list_entry), in
+    // floats (lo rounded down, hi up), with the polygon's index and surface. A ray that misses
+    // the box misses the polygon, so only the few rays that meet it read the polygon's ray
+    // record (octree_stats on 200,000 quads: 6 % of the tests; the room 11 %). Two to a cache
+    // line, a leaf's entries one after the other.
+    struct alignas(32) ListEntry {
+        std::array<float, 3> lo, hi;
+        int polygon = -1;
+        int surface = -1;
+    };
     static Box3 child_cube(const Box3& cube, int i);
     struct Query;
     struct ChildHits;
-    struct Numbering;
-    Node build(const Box3& cube, std::vector<int> ids, int depth, Numbering& numbering);
-    void make_records(Numbering& numbering);
+    Node build(const Box3& cube, std::vector<int> ids, int depth,
+               const std::vector<ListEntry>& entry_of);
+    void make_records();
     Box3 grown(const Box3& cube) const;
-    bool traverse(const Node& node, Query& query) const;
+    bool traverse(const Node& node, const Box3& cube, Query& query) const;
     bool test_leaf(const Node& node, Query& query) const;
-    void prefetch_records(const Node& leaf) const;
-    ChildHits child_hits(const Block& block, unsigned mask, const Query& query) const;
+    void prefetch_list(const Node& leaf) const;
+    ListEntry list_entry(int id) const;
+    ChildHits child_hits(const Box3& cube, unsigned mask, const Query& query) const;
     template <class NodeTest>
     void collect(const Node& node, const Box3& cube, NodeTest& test, std::vector<int>& out) const;
 
@@ -244,16 +259,17 @@ private:
     bool has_root_ = false;      // false for an empty tree
     Node root_;                  // the root (its cube is root_cube_)
     std::vector<Block> blocks_;  // the internal nodes' blocks, in depth-first order
-    std::vector<int> leaf_records_;    // the leaves' lists of record numbers, one after another
-    std::vector<RayRecord> records_;   // in the order the leaves first list them
-    std::vector<int> record_polygon_;  // records_[r].polygon, compact (for collect)
-    std::vector<Plane> extra_planes_;  // bounding planes of polygons with more than four
+    std::vector<ListEntry> leaf_entries_;  // the leaves' lists, one after another
+    std::vector<RayRecord> records_;       // records_[id]: polygon id's
+    std::vector<Plane> extra_planes_;      // bounding planes of polygons with more than four
     // DESIGN: past Options::prefetch_bytes of records, random rays wait on memory at every node and
     // record (octree_stats on 200,000 quads, 37 MiB of records: `perf` put a third of the
     // time on the load of a record's first line and a fifth on the leaf's list), so queries
-    // ask for the children they will visit and for the records of a leaf ahead of reading
-    // them. Below it the tree stays in the cache and the prefetches only cost (the room,
-    // 2,558 polygons: any-hit rays 15 % slower). Measured in docs/method.md, "Octree and rays".
+    // ask for the children they will visit and for a leaf's list ahead of reading them (the
+    // records themselves were asked for too until the lists held the boxes), and for the
+    // polygon of each new best hit, which the hit's (u, v) reads at the end. Below it the tree
+    // stays in the cache and the prefetches only cost (the room, 2,558 polygons: any-hit rays
+    // 15 % slower). Measured in docs/method.md, "Octree and rays".
     bool prefetch_ = false;
     int node_count_ = 0;
     int leaf_count_ = 0;
@@ -269,13 +285,12 @@ void Octree::collect(const Node& node, const Box3& cube, NodeTest& test,
     if (!test(grown(cube))) return;
     if (node.is_leaf()) {
         for (int r = node.first, end = node.first + node.count(); r < end; ++r)
-            out.push_back(record_polygon_[leaf_records_[r]]);
+            out.push_back(leaf_entries_[size_t(r)].polygon);
         return;
     }
     const Block& block = blocks_[node.first];
     for (int i = 0; i < 8; ++i)
-        if ((node.child_mask() >> i) & 1)
-            collect(block.child[i], child_cube(block.cube, i), test, out);
+        if ((node.child_mask() >> i) & 1) collect(block.child[i], child_cube(cube, i), test, out);
 }
 
 }  // namespace mbr

@@ -764,6 +764,78 @@ TEST_CASE("octree: concurrent queries agree with sequential ones", "[octree]") {
     CHECK(parallel == sequential);
 }
 
+TEST_CASE("octree: hits in a polygon's slack beyond its edges and corners are found", "[octree]") {
+    // A leaf tests a polygon's box before its planes (Octree::ListEntry): the box must hold
+    // every hit the bounding planes accept, which reach edge_slack() beyond each edge and
+    // slack / sin(theta / 2) beyond a corner of angle theta. Rays aimed just inside that reach
+    // (axis-aligned squares, whose edges are their box's faces; slivers with corners of 0.01 and
+    // 0.0012 rad; polygons of size 1e-3 to 1e3, alone and in a crowd, from steep to grazing)
+    // must find what Polygon::intersect finds.
+    std::mt19937 rng(2718);
+    std::uniform_real_distribution<double> u01(0, 1);
+    int n_checked = 0, n_hits = 0;
+    for (int trial = 0; trial < 60; ++trial) {
+        const double size = std::pow(10.0, -3 + 6 * u01(rng));
+        const Vec3 c{size * (u01(rng) - 0.5), size * (u01(rng) - 0.5), size * (u01(rng) - 0.5)};
+        std::vector<Vec3> v;
+        switch (trial % 3) {
+            case 0:  // an axis-aligned square
+                v = {c, c + Vec3{size, 0, 0}, c + Vec3{size, size, 0}, c + Vec3{0, size, 0}};
+                break;
+            case 1:
+            case 2: {  // a sliver triangle, its sharpest corner at v[0]
+                const double angle = trial % 3 == 1 ? 0.01 : 0.0012;
+                const Vec3 n = random_unit(rng);
+                const Vec3 a =
+                    normalize(cross(std::fabs(n.x) < 0.9 ? Vec3{1, 0, 0} : Vec3{0, 1, 0}, n));
+                const Vec3 b = cross(n, a);
+                v = {c, c + size * a, c + size * (std::cos(angle) * a + std::sin(angle) * b)};
+                break;
+            }
+        }
+        std::vector<Polygon> scene{make_polygon(v, 0)};
+        if (trial % 2 == 1)  // in a crowd of others, so that the tree has leaves
+            for (Polygon& p : random_scene(rng, 200)) scene.push_back(p);
+        const Polygon& target = scene[0];
+        const double slack = target.edge_slack();
+        const Vec3 n = target.normal();
+        // Points in the polygon's plane just inside the slack's reach: beyond each edge's middle
+        // by 0.9 slack, and beyond each corner along its bisector by 0.9 slack / sin(theta / 2).
+        std::vector<Vec3> aims;
+        const int k = target.n_vertices();
+        for (int i = 0; i < k; ++i) {
+            const Vec3 p0 = v[size_t(i)], p1 = v[size_t((i + 1) % k)],
+                       prev = v[size_t((i + k - 1) % k)];
+            const Vec3 out = normalize(cross(p1 - p0, n));
+            aims.push_back(0.5 * (p0 + p1) + 0.9 * slack * out);
+            const Vec3 e_in = normalize(p0 - prev), e_out = normalize(p1 - p0);
+            const Vec3 bisector = normalize(e_in - e_out);  // points away from the polygon
+            const double sin_half = std::sqrt(std::max(0.0, 0.5 * (1 + dot(e_in, e_out))));
+            aims.push_back(p0 + 0.9 * slack / sin_half * bisector);
+        }
+        Octree octree(scene);
+        for (const Vec3& aim : aims)
+            for (double steep : {1.0, 0.1, 1e-3}) {  // the cosine of the ray's angle to the normal
+                const Vec3 side = normalize(cross(n, random_unit(rng)));
+                const Vec3 dir = steep * n + std::sqrt(1 - steep * steep) * side;
+                const Ray ray{aim + 2 * size * dir, -1.0 * dir};
+                CAPTURE(trial, size, aim, steep, ray);
+                const std::optional<Hit> expected = brute_closest(scene, ray);
+                const std::optional<Hit> hit = octree.closest_hit(ray);
+                REQUIRE(bool(hit) == bool(expected));
+                if (hit) {
+                    CHECK(hit->polygon == expected->polygon);
+                    CHECK(hit->t == expected->t);
+                    n_hits += expected->polygon == 0;
+                }
+                CHECK(octree.any_hit(ray) == brute_any(scene, ray));
+                ++n_checked;
+            }
+    }
+    // Most aims are accepted by the target's own test (rounding decides the others).
+    CHECK(n_hits > n_checked / 2);
+}
+
 // ---- Segments between true surfaces: a polygon's thickness (polygon.h) -------------------------
 
 TEST_CASE("octree: a hit within a polygon's thickness of a segment's end does not block",
