@@ -112,6 +112,8 @@ Polygon::Polygon(std::vector<Vec3> vertices, std::vector<Vec2> uv, int surface)
             parallelogram_ = true;
             inverse_s_ = (f.y / det) * axis_u_ - (f.x / det) * axis_v_;
             inverse_t_ = (e.x / det) * axis_v_ - (e.y / det) * axis_u_;
+            origin_ = vertices_[0];
+            std::copy(uv_.begin(), uv_.end(), corner_uv_.begin());
         }
     }
 }
@@ -162,8 +164,11 @@ Vec2 Polygon::to_local(Vec3 p) const {
 
 Vec2 Polygon::uv_at(Vec3 p) const {
     if (parallelogram_) {
-        const Vec3 d = p - vertices_[0];
-        return uv_bilinear(dot(d, inverse_s_), dot(d, inverse_t_));
+        const Vec3 d = p - origin_;
+        const double s = dot(d, inverse_s_), t = dot(d, inverse_t_);
+        // uv_bilinear's blend, on the inline copy of the corners' (u, v).
+        return (1 - s) * (1 - t) * corner_uv_[0] + s * (1 - t) * corner_uv_[1] +
+               s * t * corner_uv_[2] + (1 - s) * t * corner_uv_[3];
     }
     Vec2 q = to_local(p);
     if (n_vertices() == 3) {

@@ -189,6 +189,11 @@ private:
     // A parallelogram's inverse map: (s, t) = (dot(p - vertex 0, inverse_s_), dot(.., inverse_t_)).
     bool parallelogram_ = false;
     Vec3 inverse_s_, inverse_t_;
+    // And, for it, vertex 0 and the four vertices' (u, v) inline: a closest hit's (u, v) then
+    // reads this object only (the octree asks for it as soon as the hit is found), not the
+    // vectors' storage.
+    Vec3 origin_;
+    std::array<Vec2, 4> corner_uv_;
 };
 
 /// Prints the surface id and the vertices.

@@ -42,12 +42,13 @@ constexpr double hidden_seconds_per_surface = 0.025;
 // Calibration of the polygons (octree_stats examples/scenes/room.scene --tessellation T
 // --rays 1000, peak resident size): 6,984 KB at T = 24 (2,558 polygons), 65,540 KB at T = 128
 // (66,830), 249,152 KB at T = 256 (264,718): about 930-945 bytes a polygon, counting the
-// facets, the polygons with their planes, and the octree's references and nodes (306,280 KB
-// at T = 256 since the leaves' lists hold boxes, 32 bytes a reference: 1,185 bytes). A whole
-// solve holds more a polygon: a unit sphere at T = 1024 (1,048,576 polygons) under a lamp,
-// `mbr probe`, peaked at 1,184,952 KB, about 1,100 bytes a polygon beyond the rest of the
-// estimate.
-constexpr double bytes_per_polygon = 1200;
+// facets, the polygons with their planes, and the octree's references and nodes (328,164 KB
+// at T = 256 since the leaves' lists hold boxes, 32 bytes a reference, and a parallelogram
+// keeps its corners' (u, v) inline: 1,269 bytes). A whole solve holds more a polygon: a unit
+// sphere at T = 1024 (1,048,576 polygons) under a lamp, `mbr probe`, peaked at 1,184,952 KB,
+// about 1,100 bytes a polygon beyond the rest of the estimate; on 2026-12-07 at 1,325,604 KB
+// before those two changes and 1,503,088 KB after (about 1,390 bytes a polygon).
+constexpr double bytes_per_polygon = 1450;
 
 // The program before any scene: 6,488 KB resident (single_transfer --depth 0 above), 6.2-6.9 MB
 // for mbr probe of a small scene.
