@@ -390,8 +390,6 @@ void Octree::make_records() {
         RayRecord& r = records_[size_t(id)];
         r.plane = p.plane();
         r.slack = p.edge_slack();
-        r.polygon = id;
-        r.surface = p.surface();
         r.n_planes = p.n_vertices();
         r.first_extra = static_cast<int>(extra_planes_.size());
         const std::vector<Plane>& b = p.bounding_planes();

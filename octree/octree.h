@@ -24,8 +24,8 @@
 // (child_cube, as the build did) and works out the six slabs of the children's grown cubes once.
 // A leaf's list is a slice of one array of 32-byte entries, each a polygon's index and surface
 // and the box, in floats, that a hit on it must lie in; only a ray that meets the box reads the
-// polygon's "ray record": what the ray-polygon test reads of it (its plane, bounding planes,
-// slack, surface and index) in three cache lines. Queries keep their state on the stack. When
+// polygon's "ray record": what the ray-polygon test reads of it (its plane, bounding planes
+// and slack) in three cache lines. Queries keep their state on the stack. When
 // the records outgrow the cache (OctreeOptions::prefetch_bytes), queries ask the memory for the
 // children and lists they will read next before reading them, and for the polygon of a new best
 // hit (prefetch_).
@@ -212,13 +212,11 @@ private:
         std::array<Node, 8> child;
     };
     // What the ray-polygon test reads of one polygon, packed: copies of Polygon's plane, slack
-    // and bounding planes (inline up to four, else extra_planes_[first_extra ..]), its surface
-    // and its index in polygons_.
+    // and bounding planes (inline up to four, else extra_planes_[first_extra ..]). Its index
+    // and surface are in the list entries that lead to it.
     struct alignas(64) RayRecord {
         Plane plane;
         double slack = 0;
-        int polygon = -1;
-        int surface = -1;
         int n_planes = 0;
         int first_extra = 0;
         std::array<Plane, 4> planes;
