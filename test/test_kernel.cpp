@@ -18,11 +18,13 @@
 // - brute-force tensor Gauss-Legendre quadrature of F over a polygon or a shooter.
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <cstring>
 #include <random>
 #include <vector>
 
 #include "math/gauss_legendre.h"
 #include "radiosity/reference/configurations.h"
+#include "radiosity/transfer/form_factor.h"
 #include "radiosity/transfer/sample_values.h"
 #include "test/report.h"
 
@@ -168,6 +170,60 @@ TEST_CASE("kernel: F is symmetric, non-negative and zero behind either surface",
               Approx(1 / (Pi * h * h)).epsilon(1e-15));
     // Grazing: a point in the other's plane receives nothing.
     CHECK(form_factor_kernel({0, 0, 0}, {0, 0, 1}, {1, 0, 0}, {0, 0, -1}) == 0);
+}
+
+TEST_CASE("kernel: the vectorised kernel gives form_factor_kernel's values to the bit",
+          "[kernel]") {
+    // form_factor_kernels (arrays of points, several per vector instruction, an AVX2 clone
+    // where the processor has one) against form_factor_kernel one point at a time: random
+    // pairs facing and not, points on p's tangent plane or the node's (zero cosines), a node
+    // at p itself (|l| = 0) and at distances from 1e-6 to 1e6, in runs of every length from 0
+    // to 37 (the vector loop's remainders).
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<double> u(-2, 2);
+    std::uniform_int_distribution<int> kind(0, 5);
+    struct Node {
+        Vec3 x, n;
+    };
+    int facing = 0, zero = 0;
+    for (int trial = 0; trial < 400; ++trial) {
+        const Vec3 p{u(rng), u(rng), u(rng)};
+        const Vec3 n_p = random_unit(rng);
+        const int count = trial % 38;
+        std::vector<Node> nodes;
+        for (int i = 0; i < count; ++i) {
+            Vec3 x{u(rng), u(rng), u(rng)};
+            Vec3 n = random_unit(rng);
+            switch (kind(rng)) {
+                case 0: x = p; break;                                  // the node at p
+                case 1: x = x - dot(x - p, n_p) * n_p; break;          // on p's tangent plane
+                case 2: n = normalize(cross(x - p, random_unit(rng))); break;  // grazing the node
+                case 3: x = p + std::pow(10.0, 12 * (u(rng) + 2) / 4 - 6) * random_unit(rng); break;
+                default: break;
+            }
+            nodes.push_back({x, n});
+        }
+        std::vector<double> block;
+        append_shooting_nodes(block, nodes.data(), count);
+        std::vector<double> F(size_t(count) + 1, -1.0);
+        form_factor_kernels(p, n_p, shooting_nodes(block.data(), count), count, F.data());
+        for (int i = 0; i < count; ++i) {
+            const double expect = form_factor_kernel(p, n_p, nodes[i].x, nodes[i].n);
+            CAPTURE(trial, i, p, n_p, nodes[i].x, nodes[i].n);
+            CHECK(std::memcmp(&F[size_t(i)], &expect, sizeof(double)) == 0);
+            (expect > 0 ? facing : zero) += 1;
+        }
+        CHECK(F[size_t(count)] == -1.0);  // nothing written past the run
+        // A run that starts inside the block (sum_over's chunks) reads the same nodes.
+        if (count > 5) {
+            std::vector<double> G(size_t(count) - 5);
+            form_factor_kernels(p, n_p, shooting_nodes(block.data(), count, 5), count - 5,
+                                G.data());
+            for (int i = 5; i < count; ++i) CHECK(G[size_t(i) - 5] == F[size_t(i)]);
+        }
+    }
+    CHECK(facing > 500);
+    CHECK(zero > 1000);
 }
 
 TEST_CASE("kernel: analytic form factor equals the closed form for a parallel rectangle",

@@ -21,6 +21,45 @@ inline double form_factor_kernel(Vec3 p, Vec3 n_p, Vec3 x, Vec3 n_x) {
     return cos_p * cos_x / (Pi * l2 * l2);
 }
 
+/// Shooting points given component by component (structure of arrays): the i-th point is
+/// (x[i], y[i], z[i]) with unit normal (nx[i], ny[i], nz[i]).
+struct ShootingNodes {
+    const double *x, *y, *z, *nx, *ny, *nz;
+};
+
+/// The six arrays of `count` nodes stored one after the other in `block` (x first, then y, z,
+/// nx, ny, nz), from node `start` on.
+inline ShootingNodes shooting_nodes(const double* block, int count, int start = 0) {
+    return {block + start,             block + count + start,     block + 2 * count + start,
+            block + 3 * count + start, block + 4 * count + start, block + 5 * count + start};
+}
+
+/// Appends the positions and normals of `count` points to `block` in shooting_nodes' layout.
+template <class Point>
+void append_shooting_nodes(std::vector<double>& block, const Point* first, int count) {
+    const size_t base = block.size();
+    block.resize(base + 6 * size_t(count));
+    double* out = block.data() + base;
+    for (int i = 0; i < count; ++i) {
+        out[i] = first[i].x.x;
+        out[count + i] = first[i].x.y;
+        out[2 * count + i] = first[i].x.z;
+        out[3 * count + i] = first[i].n.x;
+        out[4 * count + i] = first[i].n.y;
+        out[5 * count + i] = first[i].n.z;
+    }
+}
+
+/// Eq. (3) at `count` shooting points: F[i] = form_factor_kernel(p, n_p, x_i, n_i), the same
+/// values to the bit (the same operations in the same order, no fused multiply-add), written so
+/// that the compiler evaluates several points in one vector instruction.
+/// DESIGN: the "vectorised kernel where the tensor loop is hot": the points are stored
+/// as arrays (ShootingNodes), the clamps are selects instead of branches, and on x86-64 the
+/// function is compiled twice, for AVX2 and for the baseline (function multi-versioning,
+/// chosen once at load time), so the default build runs on any x86-64 processor and gives the
+/// same bits on both (docs/method.md, "A vectorised kernel").
+void form_factor_kernels(Vec3 p, Vec3 n_p, const ShootingNodes& nodes, int count, double* F);
+
 /// The form factor from a differential area at p (unit normal n_p) to a planar polygon, by
 /// Lambert's contour integral: F = |sum_i angle(R_i, R_{i+1}) n_p . unit(R_i x R_{i+1})| / (2 pi)
 /// with R_i = v_i - p. The polygon is one-sided like the surfaces: its front (counter-clockwise

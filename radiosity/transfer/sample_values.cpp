@@ -86,7 +86,7 @@ double cached_points_bytes() {
     // Tensor points: the pool at its bound, and a map entry (about 64 bytes with its bucket)
     // per cell of at least 2 x 2 points. Horizon pieces: their points, and an entry (about 96
     // bytes with its vector) per piece, each counted as at least one point.
-    const double point = sizeof(ShooterPoint);
+    const double point = sizeof(ShooterPoint) + 6 * sizeof(double);  // and its nodes' arrays
     return double(max_cached_points) * (point + 64.0 / 4) +
            double(max_cached_horizon_points) * (point + 96);
 }
@@ -97,7 +97,8 @@ IncrementIntegrator::PointSpan IncrementIntegrator::points(const QuadCell& cell,
     const std::uint64_t key = (std::uint64_t(cell.level) << 57) | (std::uint64_t(cell.i) << 29) |
                               (std::uint64_t(cell.j) << 1) | std::uint64_t(n == options_.n ? 0 : 1);
     auto it = cache_.find(key);
-    if (it != cache_.end()) return {pool_.data() + it->second, n * n};
+    if (it != cache_.end())
+        return {pool_.data() + it->second, n * n, pool_nodes_.data() + 6 * size_t(it->second)};
     // Bound the cache (deep singular corners can make many cells): at most max_cached_points;
     // then it starts over. Values never depend on it. The pool grows as needed, so a transfer
     // that needs few points costs little memory (a span is used before the next call), and by
@@ -105,9 +106,12 @@ IncrementIntegrator::PointSpan IncrementIntegrator::points(const QuadCell& cell,
     if (pool_.size() + size_t(n) * n > max_cached_points) {
         cache_.clear();
         pool_.clear();
+        pool_nodes_.clear();
     }
-    if (pool_.size() + size_t(n) * n > pool_.capacity())
+    if (pool_.size() + size_t(n) * n > pool_.capacity()) {
         pool_.reserve(std::min(max_cached_points, std::max<size_t>(1024, 2 * pool_.capacity())));
+        pool_nodes_.reserve(6 * pool_.capacity());
+    }
     const GaussLegendre& rule = rules_[n];
     const Rect& r = cell.rect;
     const double hx = 0.5 * r.width(), hy = 0.5 * r.height();
@@ -128,16 +132,24 @@ IncrementIntegrator::PointSpan IncrementIntegrator::points(const QuadCell& cell,
             const double w_J_A = rule.w[a] * rule.w[b] * hx * hy * sp.area_factor;
             pool_.push_back({sp.position, sp.normal, w_J_A * B[a * n + b], w_J_A});
         }
+    append_shooting_nodes(pool_nodes_, pool_.data() + offset, n * n);
     cache_.emplace(key, offset);
-    return {pool_.data() + offset, n * n};
+    return {pool_.data() + offset, n * n, pool_nodes_.data() + 6 * size_t(offset)};
 }
 
 Rgb IncrementIntegrator::sum_over(const SurfacePoint& p, PointSpan pts) const {
+    // The kernel of eq. (3) at a chunk of points at once (form_factor_kernels, vectorised), then
+    // the sum in the points' order: the same bits as one point at a time.
+    constexpr int chunk = 64;
+    double F[chunk];
     Rgb sum;
-    for (int i = 0; i < pts.count; ++i) {
-        const ShooterPoint& q = pts.first[i];
-        const double F = form_factor_kernel(p.position, p.normal, q.x, q.n);  // eq. (3)
-        if (F != 0) sum += F * (q.e - q.a * b_star_);  // b_star_ is zero unless subtracting
+    for (int start = 0; start < pts.count; start += chunk) {
+        const int count = std::min(chunk, pts.count - start);
+        form_factor_kernels(p.position, p.normal, shooting_nodes(pts.nodes, pts.count, start),
+                            count, F);
+        const ShooterPoint* q = pts.first + start;
+        for (int i = 0; i < count; ++i)  // b_star_ is zero unless subtracting
+            if (F[i] != 0) sum += F[i] * (q[i].e - q[i].a * b_star_);
     }
     return sum;
 }
@@ -386,7 +398,8 @@ IncrementIntegrator::PointSpan IncrementIntegrator::horizon_points(const QuadCel
             horizon_cache_.clear();  // bound it; values never depend on it
             horizon_points_ = 0;
         }
-        std::vector<ShooterPoint> pts;
+        HorizonPoints entry;
+        std::vector<ShooterPoint>& pts = entry.points;
         ConvexPolygon piece = clip(image, view_.front);
         // A horizon through a corner of the cell leaves a near-repeated vertex where rounding
         // decides, and with it a fan triangle of no area (its points cost evaluations and add
@@ -412,10 +425,12 @@ IncrementIntegrator::PointSpan IncrementIntegrator::horizon_points(const QuadCel
         }
         horizon_points_ += pts.size() + 1;  // an empty piece's entry counts as one
         pts.shrink_to_fit();
-        it = horizon_cache_.emplace(key, std::move(pts)).first;
+        append_shooting_nodes(entry.nodes, pts.data(), static_cast<int>(pts.size()));
+        it = horizon_cache_.emplace(key, std::move(entry)).first;
     }
-    extra_evaluations_ += long(it->second.size()) - long(n) * n;  // the rule counts n^2 per cell
-    return {it->second.data(), static_cast<int>(it->second.size())};
+    const std::vector<ShooterPoint>& pts = it->second.points;
+    extra_evaluations_ += long(pts.size()) - long(n) * n;  // the rule counts n^2 per cell
+    return {pts.data(), static_cast<int>(pts.size()), it->second.nodes.data()};
 }
 
 void IncrementIntegrator::collect_shaft_occluders(const SurfacePoint& p, const QuadCell& cell,

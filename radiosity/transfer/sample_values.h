@@ -186,6 +186,7 @@ public:
     struct PointSpan {
         const ShooterPoint* first;
         int count;
+        const double* nodes;  // their positions and normals as arrays (shooting_nodes' block)
     };
     PointSpan points(const QuadCell& cell, int n);
     /// The shooter's plane when it is a planar quad, else null.
@@ -271,11 +272,16 @@ private:
     std::shared_ptr<const PolynomialPatches> unshot_patches_;  // B_h at scattered points
     std::optional<Plane> receiver_plane_;  // set_receiver_plane
     /// The front pieces' points of cells only the (fixed) horizon cuts, per cell and rule.
-    std::unordered_map<std::uint64_t, std::vector<ShooterPoint>> horizon_cache_;
+    struct HorizonPoints {
+        std::vector<ShooterPoint> points;
+        std::vector<double> nodes;  // shooting_nodes' block of the points
+    };
+    std::unordered_map<std::uint64_t, HorizonPoints> horizon_cache_;
     size_t horizon_points_ = 0;  // points in horizon_cache_ (each entry counts at least one)
     PointSpan horizon_points(const QuadCell& cell, int n, const ConvexPolygon& image);
     std::vector<GaussLegendre> rules_;  // rules_[n]
     std::vector<ShooterPoint> pool_;    // every cached cell's points, one after the other
+    std::vector<double> pool_nodes_;    // each cell's shooting_nodes block, at 6 x its offset
     std::vector<Rgb> unshot_values_;    // scratch: B_h on one cell's grid
     std::unordered_map<std::uint64_t, std::uint32_t> cache_;  // cell key -> offset in pool_
     double unshot_bound_ = 0;       // max |B_h| bound: the largest coefficient
