@@ -58,9 +58,10 @@ ConvexPolygon clip(const ConvexPolygon& polygon, const HalfPlane& h) {
 
 ConvexPolygon intersect(const ConvexPolygon& a, const ConvexPolygon& b) {
     // Two buffers in turn: one allocation each, not one per clipping line.
-    ConvexPolygon out = a, next;
+    ConvexPolygon out, next;
     out.reserve(a.size() + b.size());
     next.reserve(a.size() + b.size());
+    out.assign(a.begin(), a.end());
     const size_t n = b.size();
     for (size_t i = 0; i < n && !out.empty(); ++i) {
         clip_into(out, left_of(b[i], b[(i + 1) % n]), next);
@@ -77,14 +78,26 @@ std::vector<ConvexPolygon> subtract(const ConvexPolygon& a, const ConvexPolygon&
         if (!a.empty()) pieces.push_back(a);
         return pieces;
     }
-    ConvexPolygon rest = a;  // the part of a still inside every edge line of b seen so far
+    // The part of a still inside every edge line of b seen so far, in two buffers in turn, and
+    // a piece's buffer that is handed over only when the piece is kept (allocations per call,
+    // not per edge).
     const size_t n = b.size();
+    ConvexPolygon rest, next, piece;
+    rest.reserve(a.size() + n);
+    next.reserve(a.size() + n);
+    piece.reserve(a.size() + n);
+    rest.assign(a.begin(), a.end());
     for (size_t i = 0; i < n && !rest.empty(); ++i) {
         const HalfPlane inside = left_of(b[i], b[(i + 1) % n]);
         const HalfPlane outside{-1.0 * inside.normal, -inside.offset};
-        ConvexPolygon piece = clip(rest, outside);
-        if (!piece.empty() && signed_area(piece) > min_area) pieces.push_back(std::move(piece));
-        rest = clip(rest, inside);
+        clip_into(rest, outside, piece);
+        if (!piece.empty() && signed_area(piece) > min_area) {
+            pieces.push_back(std::move(piece));
+            piece = ConvexPolygon();
+            piece.reserve(a.size() + n);
+        }
+        clip_into(rest, inside, next);
+        rest.swap(next);
     }
     // What is left of a lies inside b: removed.
     return pieces;

@@ -56,7 +56,7 @@ double IncrementIntegrator::visible_form_factor(const SurfacePoint& p) {
     // counter-clockwise seen from the shooter's front).
     if (view_.behind_all) return 0;
     ++n_analytic_;
-    std::vector<Vec3> polygon;
+    std::vector<Vec3>& polygon = lambert_polygon_;  // its storage reused from point to point
     auto lambert = [&](const ConvexPolygon& piece) {
         polygon.clear();
         for (const Vec2& q : piece) polygon.push_back(plane_.to_space(q));
@@ -226,6 +226,8 @@ Rgb IncrementIntegrator::shadow_integral(const SurfacePoint& p, double tolerance
     auto worse = [](const Item& x, const Item& y) { return x.error < y.error; };
     const int n_tri = options_.n_pieces > 0 ? options_.n_pieces : options_.n;
     std::vector<ShadowTriangle> todo;
+    heap.reserve(32);  // room for a typical refinement at once (as adaptive_tensor_rule_2d's)
+    todo.reserve(32);
     for (size_t r = 0; r < shadow_regions_.size(); ++r)
         for (size_t k = 1; k + 1 < shadow_regions_[r].size(); ++k)
             todo.push_back({int(r), int(k), {{0, 0}, {1, 0}, {0, 1}}, 0});
@@ -346,12 +348,13 @@ void IncrementIntegrator::set_view(const SurfacePoint& p) {
     shadow_regions_.clear();
 }
 
-ConvexPolygon IncrementIntegrator::cell_image(const QuadCell& cell) const {
+void IncrementIntegrator::cell_image(const QuadCell& cell, ConvexPolygon& image) const {
     // Iso-parameter lines of a bilinear map are straight: a cell's image is the quadrilateral of
-    // its corners (counter-clockwise, as the whole quad's).
+    // its corners (counter-clockwise, as the whole quad's). Written into `image`, whose storage
+    // is reused from cell to cell.
     const Rect& r = cell.rect;
-    return {plane_.at(r.x0, r.y0), plane_.at(r.x1, r.y0), plane_.at(r.x1, r.y1),
-            plane_.at(r.x0, r.y1)};
+    image.assign({plane_.at(r.x0, r.y0), plane_.at(r.x1, r.y0), plane_.at(r.x1, r.y1),
+                  plane_.at(r.x0, r.y1)});
 }
 
 Rgb IncrementIntegrator::pieces_value(const SurfacePoint& p,
@@ -534,7 +537,8 @@ void IncrementIntegrator::collect_shaft_occluders(const SurfacePoint& p, const Q
 Rgb IncrementIntegrator::cell_value(const SurfacePoint& p, const QuadCell& cell, int n) {
     const bool rays = !planar_ || view_.use_rays;  // visibility by one ray per node
     if (planar_ && !view_.trivial() && !view_.use_rays) {
-        const ConvexPolygon image = cell_image(cell);
+        cell_image(cell, image_);
+        const ConvexPolygon& image = image_;
         bool shadowed = false;
         switch (classify_cell(image, view_, &shadowed)) {
             case CellVisibility::hidden:

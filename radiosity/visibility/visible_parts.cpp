@@ -276,6 +276,7 @@ std::optional<ConvexPolygon> solid_shadow(const ShooterPlane& plane, Vec3 p, dou
                 if (std::fabs(h[size_t(k)]) > tol) return std::nullopt;
     }
     std::vector<Vec3> slab;
+    slab.reserve(h.size() + 8);  // the corners in the slab and a few edges' crossings
     for (size_t k = 0; k < h.size(); ++k)
         if (h[k] >= 0 && h[k] <= h_max) slab.push_back(solid.vertices[k]);
     for (const std::array<int, 2>& e : solid.edges)
@@ -417,6 +418,7 @@ void merge_shadows(std::vector<ConvexPolygon>& shadows) {
     // its silhouette's).
     // DESIGN: the convexity test's tolerance, 1e-9 of the hull's area, only absorbs rounding.
     std::vector<Rect> boxes;
+    boxes.reserve(shadows.size());
     for (const ConvexPolygon& s : shadows) boxes.push_back(bounding_rect(s));
     for (bool merged = true; merged;) {
         merged = false;
