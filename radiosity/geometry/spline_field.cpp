@@ -4,10 +4,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <vector>
 
 #include "math/check.h"
 #include "math/gauss_legendre.h"
+#include "math/simd.h"
 #include "math/wavelet.h"
 
 namespace mbr {
@@ -110,6 +112,28 @@ void SplineField::evaluate_grid(const double* s, int n_s, const double* t, int n
     }
 }
 
+MBR_VECTOR_CLONES
+Rgb horner_patch_m4(const double* C, double lx, double ly) {
+    // PolynomialPatches::horner_cell for m = 4, its operations in its order, lane by lane.
+    typedef double Lanes __attribute__((vector_size(4 * sizeof(double))));
+    constexpr int m = 4, lanes = PolynomialPatches::lanes;
+    const Lanes X = {lx, lx, lx, lx}, Y = {ly, ly, ly, ly};
+    Lanes row_value[m];  // the polynomial in y of x^p's coefficients, at ly
+    for (int p = 0; p < m; ++p) {
+        const double* row = C + p * m * lanes;
+        Lanes r, c;
+        std::memcpy(&r, row + (m - 1) * lanes, sizeof r);
+        for (int q = m - 2; q >= 0; --q) {
+            std::memcpy(&c, row + q * lanes, sizeof c);
+            r = r * Y + c;
+        }
+        row_value[p] = r;
+    }
+    Lanes v = row_value[m - 1];
+    for (int p = m - 2; p >= 0; --p) v = v * X + row_value[p];
+    return {v[0], v[1], v[2]};
+}
+
 PolynomialPatches::PolynomialPatches(const SplineField& field) {
     if (field.empty()) return;
     const int m = m_ = field.order();
@@ -154,18 +178,18 @@ PolynomialPatches::PolynomialPatches(const SplineField& field) {
     }
     // Cell (i, j): basis k = i - r (r = 0 .. m-1) is P_r there; C[p][q] = sum c_{i-r, j-r'}
     // P[r][p] P[r'][q].
-    c_.assign(size_t(cells_) * cells_ * 3 * m * m, 0.0);
+    c_.assign(size_t(cells_) * cells_ * lanes * m * m, 0.0);
     for (int j = 0; j < cells_; ++j)
         for (int i = 0; i < cells_; ++i)
             for (int ch = 0; ch < 3; ++ch) {
-                double* C = &c_[(size_t(j) * cells_ + i) * 3 * m * m];
+                double* C = &c_[(size_t(j) * cells_ + i) * lanes * m * m];
                 for (int r = 0; r < m; ++r)
                     for (int r2 = 0; r2 < m; ++r2) {
                         const double a = field.coefficient(i - r, j - r2)[ch];
                         if (a == 0) continue;
                         for (int p = 0; p < m; ++p)
                             for (int q = 0; q < m; ++q)
-                                C[(p * m + q) * 3 + ch] +=
+                                C[(p * m + q) * lanes + ch] +=
                                     a * P[size_t(r) * m + p] * P[size_t(r2) * m + q];
                     }
             }

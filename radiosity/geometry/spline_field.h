@@ -65,6 +65,15 @@ private:
     std::array<CoefficientGrid, 3> grid_;
 };
 
+/// Horner's rule in both directions on one cell of a PolynomialPatches of order 4: the 4 x 4
+/// coefficients of x^p y^q, each four doubles (r, g, b and a zero), at (lx, ly) in the cell.
+/// DESIGN: the four lanes are one vector of the compiler's vector extension, and the function is
+/// compiled for AVX2 and the baseline (math/simd.h): 15 multiplications and additions of one
+/// 256-bit vector (two 128-bit ones on the baseline) instead of three channels' scalars and
+/// pairs; each lane's operations are horner_cell's in its order, so the values are the same to
+/// the bit (docs/method.md, "A vectorised kernel").
+Rgb horner_patch_m4(const double* C, double lx, double ly);
+
 /// The same function as a SplineField, stored per level-j knot cell as m x m tensor polynomials
 /// in the cell's own coordinates: for evaluating one field at many scattered points (Horner's
 /// rule instead of the B-spline recursion and m^2 coefficient look-ups of evaluate()).
@@ -80,27 +89,24 @@ public:
         const int i = std::min(cells_ - 1, static_cast<int>(x)),
                   j = std::min(cells_ - 1, static_cast<int>(y));
         const double lx = x - i, ly = y - j;
-        const double* C = &c_[(size_t(j) * cells_ + i) * 3 * m_ * m_];
-        return m_ == 4 ? horner_cell<4>(C, 4, lx, ly) : horner_cell<0>(C, m_, lx, ly);
+        const double* C = &c_[(size_t(j) * cells_ + i) * lanes * m_ * m_];
+        return m_ == 4 ? horner_patch_m4(C, lx, ly) : horner_cell(C, m_, lx, ly);
     }
+    /// Doubles per coefficient: the three channels and a zero (one 256-bit vector).
+    static constexpr int lanes = 4;
 
-private:
-    /// Horner's rule in both directions on one cell's m x m x 3 coefficients (channel
-    /// innermost), the three channels at once; M > 0 fixes the order at compile time (the
-    /// common m = 4). DESIGN: each polynomial starts from its top coefficient (not from 0 x
-    /// ly + c, the same value) and the channels are loops over arrays: the compiler then pairs
-    /// two channels in vector operations, 60 arithmetic instructions instead of 96 for m = 4,
-    /// each channel's arithmetic and values as before. It runs at every node of the shadowed
-    /// part's triangles (a tenth of the Cornell box's time).
-    template <int M>
-    static Rgb horner_cell(const double* C, int m_runtime, double lx, double ly) {
-        const int m = M > 0 ? M : m_runtime;
+    /// Horner's rule in both directions on one cell's m x m x lanes coefficients (channel
+    /// innermost), the three channels at once (any m; horner_patch_m4 is the same for m = 4).
+    /// DESIGN: each polynomial starts from its top coefficient (not from 0 x ly + c, the same
+    /// value). It runs at every node of the shadowed part's triangles (a tenth of the Cornell
+    /// box's time).
+    static Rgb horner_cell(const double* C, int m, double lx, double ly) {
         // The polynomial in y of x^p's coefficients (row p: y^0 .. y^(m-1)) at ly.
         auto in_y = [&](int p, double(&r)[3]) {
-            const double* row = C + p * m * 3;
-            for (int k = 0; k < 3; ++k) r[k] = row[(m - 1) * 3 + k];
+            const double* row = C + p * m * lanes;
+            for (int k = 0; k < 3; ++k) r[k] = row[(m - 1) * lanes + k];
             for (int q = m - 2; q >= 0; --q)
-                for (int k = 0; k < 3; ++k) r[k] = r[k] * ly + row[q * 3 + k];
+                for (int k = 0; k < 3; ++k) r[k] = r[k] * ly + row[q * lanes + k];
         };
         double v[3], r[3];
         in_y(m - 1, v);
@@ -111,9 +117,11 @@ private:
         return {v[0], v[1], v[2]};
     }
 
+private:
     int m_ = 0, cells_ = 0;
-    std::vector<double>
-        c_;  // cell (i, j), x^p y^q, channel ch: c_[(j * cells + i) * 3 m^2 + (p m + q) 3 + ch]
+    // cell (i, j), x^p y^q, channel ch: c_[(j * cells + i) lanes m^2 + (p m + q) lanes + ch]
+    // (the fourth lane zero)
+    std::vector<double> c_;
 };
 
 }  // namespace mbr

@@ -1,21 +1,12 @@
-// radiosity/transfer/form_factor.cpp - the analytic point-to-polygon form factor (paper section 7,
-// the exact reference of "an analytic formula advocated in [7]").
+// radiosity/transfer/form_factor.cpp - the kernel of eq. (3) on arrays of points (vectorised) and
+// the analytic point-to-polygon form factor (paper section 7, the exact reference of "an
+// analytic formula advocated in [7]").
 #include "radiosity/transfer/form_factor.h"
 
 #include <algorithm>
 #include <cmath>
 
-// Function multi-versioning (GCC and Clang on x86-64 ELF with glibc's indirect functions): an
-// AVX2 clone beside the baseline one. AVX2 alone does not enable fused multiply-add, so the
-// clones round alike.
-#if defined(__x86_64__) && defined(__ELF__) && defined(__GLIBC__) && defined(__has_attribute)
-#if __has_attribute(target_clones)
-#define MBR_VECTOR_CLONES __attribute__((target_clones("avx2", "default")))
-#endif
-#endif
-#ifndef MBR_VECTOR_CLONES
-#define MBR_VECTOR_CLONES
-#endif
+#include "math/simd.h"
 
 namespace mbr {
 
