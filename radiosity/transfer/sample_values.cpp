@@ -174,26 +174,50 @@ Rgb IncrementIntegrator::triangle_value(const SurfacePoint& p, const ShadowTrian
     if (t.jacobian <= 0) return sum;
     const Rgb constant_b = unshot_constant_ ? shooter_.unshot.coefficient(0, 0) : Rgb{};
     const Vec2 ab = t.b - t.a, ac = t.c - t.a;
-    const size_t n_points = rule.points.size();
+    const int n_points = static_cast<int>(rule.points.size());
     const Vec2* points = rule.points.data();
     const double* weights = rule.weights.data();
     extra_evaluations_ += long(n_points);
     const Rgb b_star = b_star_;
-    for (size_t q = 0; q < n_points; ++q) {
-        const double xi = points[q].x, eta = points[q].y;
-        const Vec2 X = t.a + xi * ab + eta * ac;
-        const double F =
-            form_factor_kernel(p.position, p.normal, plane_.to_space(X), plane_.normal);
-        if (F == 0) continue;
-        Rgb B = constant_b;
+    // The nodes in passes, each a short loop over independent nodes (the processor overlaps
+    // their chains: Newton's divisions, Horner's rule) instead of one node's whole chain after
+    // another; then the sum in the nodes' order, so the value is the same to the bit.
+    constexpr int chunk = 32;
+    double block[6 * chunk], F[chunk];
+    Vec2 X[chunk], uv[chunk];
+    Rgb B[chunk];
+    for (int start = 0; start < n_points; start += chunk) {
+        const int count = std::min(chunk, n_points - start);
+        for (int i = 0; i < count; ++i) {  // the nodes in the plane and in space
+            const Vec2 node = points[start + i];
+            X[i] = t.a + node.x * ab + node.y * ac;
+            const Vec3 x = plane_.to_space(X[i]);
+            block[i] = x.x;
+            block[count + i] = x.y;
+            block[2 * count + i] = x.z;
+            block[3 * count + i] = plane_.normal.x;
+            block[4 * count + i] = plane_.normal.y;
+            block[5 * count + i] = plane_.normal.z;
+        }
+        form_factor_kernels(p.position, p.normal, shooting_nodes(block, count), count, F);
         if (!unshot_constant_) {
             // At a node, the corners' affine blend refined by two Newton steps (the inverse of
-            // the bilinear map is nearly affine over one triangle).
-            const Vec2 guess = t.uv_a + xi * (t.uv_b - t.uv_a) + eta * (t.uv_c - t.uv_a);
-            const Vec2 uv = plane_.refine_parameters(X, plane_.refine_parameters(X, guess));
-            B = (*unshot_patches_)(uv.x, uv.y);
+            // the bilinear map is nearly affine over one triangle), then B_h there.
+            for (int i = 0; i < count; ++i) {
+                if (F[i] == 0) continue;
+                const Vec2 node = points[start + i];
+                const Vec2 guess =
+                    t.uv_a + node.x * (t.uv_b - t.uv_a) + node.y * (t.uv_c - t.uv_a);
+                uv[i] = plane_.refine_parameters(X[i], plane_.refine_parameters(X[i], guess));
+            }
+            for (int i = 0; i < count; ++i)
+                if (F[i] != 0) B[i] = (*unshot_patches_)(uv[i].x, uv[i].y);
         }
-        sum += (weights[q] * t.jacobian * F) * (B - b_star);
+        for (int i = 0; i < count; ++i) {
+            if (F[i] == 0) continue;
+            const Rgb Bi = unshot_constant_ ? constant_b : B[i];
+            sum += (weights[start + i] * t.jacobian * F[i]) * (Bi - b_star);
+        }
     }
     return sum;
 }
