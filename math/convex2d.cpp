@@ -25,9 +25,13 @@ void clip_into(const ConvexPolygon& polygon, const HalfPlane& h, ConvexPolygon& 
     out.clear();
     const size_t n = polygon.size();
     if (n < 3) return;
+    // Each vertex's value once, and the next index without a division (the same values).
+    double vb = h.value(polygon[0]);
     for (size_t i = 0; i < n; ++i) {
-        const Vec2 a = polygon[i], b = polygon[(i + 1) % n];
-        const double va = h.value(a), vb = h.value(b);
+        const size_t next = i + 1 == n ? 0 : i + 1;
+        const Vec2 a = polygon[i], b = polygon[next];
+        const double va = vb;
+        vb = h.value(b);
         if (va >= 0) out.push_back(a);
         // The edge crosses the line strictly (an end on the line is kept as a vertex already,
         // or is the next edge's start): add the crossing point, measured from the end nearer

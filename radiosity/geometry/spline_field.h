@@ -71,7 +71,9 @@ private:
 /// compiled for AVX2 and the baseline (math/simd.h): 15 multiplications and additions of one
 /// 256-bit vector (two 128-bit ones on the baseline) instead of three channels' scalars and
 /// pairs; each lane's operations are horner_cell's in its order, so the values are the same to
-/// the bit (docs/method.md, "A vectorised kernel").
+/// the bit. Alone it did not shorten a shadow triangle's node (the chain's latency is the same);
+/// with triangle_value's passes over independent nodes it does (docs/method.md, "A vectorised
+/// kernel").
 Rgb horner_patch_m4(const double* C, double lx, double ly);
 
 /// The same function as a SplineField, stored per level-j knot cell as m x m tensor polynomials
@@ -98,8 +100,8 @@ public:
     /// Horner's rule in both directions on one cell's m x m x lanes coefficients (channel
     /// innermost), the three channels at once (any m; horner_patch_m4 is the same for m = 4).
     /// DESIGN: each polynomial starts from its top coefficient (not from 0 x ly + c, the same
-    /// value). It runs at every node of the shadowed part's triangles (a tenth of the Cornell
-    /// box's time).
+    /// value). For m = 4 horner_patch_m4 runs instead, at every node of the shadowed part's
+    /// triangles (a tenth of the Cornell box's time).
     static Rgb horner_cell(const double* C, int m, double lx, double ly) {
         // The polynomial in y of x^p's coefficients (row p: y^0 .. y^(m-1)) at ly.
         auto in_y = [&](int p, double(&r)[3]) {

@@ -169,19 +169,28 @@ Rgb IncrementIntegrator::triangle_value(const SurfacePoint& p, const ShadowTrian
                                         int n) {
     // The triangle rule of degree 2n - 2 (tri_rules_[n]) on one triangle of the shooter's plane:
     // int F(p, x) (B_h(u(x), v(x)) - b*) dA(x).
-    const TriangleRule& rule = tri_rules_[n];
     Rgb sum;
     if (t.jacobian <= 0) return sum;
+    add_triangle_rule(p, t.a, t.b, t.c, t.jacobian, tri_rules_[n], &t, sum);
+    return sum;
+}
+
+void IncrementIntegrator::add_triangle_rule(const SurfacePoint& p, Vec2 a, Vec2 b, Vec2 c,
+                                            double jacobian, const TriangleRule& rule,
+                                            const ShadowTriangleCorners* corners, Rgb& sum) {
+    // int F(p, x) (B_h(u(x), v(x)) - b*) dA(x) on the triangle by the rule: each node's term
+    // added to `sum` in the nodes' order.
     const Rgb constant_b = unshot_constant_ ? shooter_.unshot.coefficient(0, 0) : Rgb{};
-    const Vec2 ab = t.b - t.a, ac = t.c - t.a;
+    const Vec2 ab = b - a, ac = c - a;
     const int n_points = static_cast<int>(rule.points.size());
     const Vec2* points = rule.points.data();
     const double* weights = rule.weights.data();
     extra_evaluations_ += long(n_points);
     const Rgb b_star = b_star_;
     // The nodes in passes, each a short loop over independent nodes (the processor overlaps
-    // their chains: Newton's divisions, Horner's rule) instead of one node's whole chain after
-    // another; then the sum in the nodes' order, so the value is the same to the bit.
+    // their chains: Newton's divisions or the inverse bilinear map, Horner's rule) instead of
+    // one node's whole chain after another; then the sum in the nodes' order, so the value is
+    // the same to the bit.
     constexpr int chunk = 32;
     double block[6 * chunk], F[chunk];
     Vec2 X[chunk], uv[chunk];
@@ -190,7 +199,7 @@ Rgb IncrementIntegrator::triangle_value(const SurfacePoint& p, const ShadowTrian
         const int count = std::min(chunk, n_points - start);
         for (int i = 0; i < count; ++i) {  // the nodes in the plane and in space
             const Vec2 node = points[start + i];
-            X[i] = t.a + node.x * ab + node.y * ac;
+            X[i] = a + node.x * ab + node.y * ac;
             const Vec3 x = plane_.to_space(X[i]);
             block[i] = x.x;
             block[count + i] = x.y;
@@ -201,14 +210,21 @@ Rgb IncrementIntegrator::triangle_value(const SurfacePoint& p, const ShadowTrian
         }
         form_factor_kernels(p.position, p.normal, shooting_nodes(block, count), count, F);
         if (!unshot_constant_) {
-            // At a node, the corners' affine blend refined by two Newton steps (the inverse of
-            // the bilinear map is nearly affine over one triangle), then B_h there.
-            for (int i = 0; i < count; ++i) {
-                if (F[i] == 0) continue;
-                const Vec2 node = points[start + i];
-                const Vec2 guess =
-                    t.uv_a + node.x * (t.uv_b - t.uv_a) + node.y * (t.uv_c - t.uv_a);
-                uv[i] = plane_.refine_parameters(X[i], plane_.refine_parameters(X[i], guess));
+            if (corners) {
+                // At a node, the corners' affine blend refined by two Newton steps (the inverse
+                // of the bilinear map is nearly affine over one triangle).
+                const ShadowTriangleCorners& t = *corners;
+                for (int i = 0; i < count; ++i) {
+                    if (F[i] == 0) continue;
+                    const Vec2 node = points[start + i];
+                    const Vec2 guess =
+                        t.uv_a + node.x * (t.uv_b - t.uv_a) + node.y * (t.uv_c - t.uv_a);
+                    uv[i] =
+                        plane_.refine_parameters(X[i], plane_.refine_parameters(X[i], guess));
+                }
+            } else {
+                for (int i = 0; i < count; ++i)
+                    if (F[i] != 0) uv[i] = plane_.parameters(X[i]);
             }
             for (int i = 0; i < count; ++i)
                 if (F[i] != 0) B[i] = (*unshot_patches_)(uv[i].x, uv[i].y);
@@ -216,10 +232,9 @@ Rgb IncrementIntegrator::triangle_value(const SurfacePoint& p, const ShadowTrian
         for (int i = 0; i < count; ++i) {
             if (F[i] == 0) continue;
             const Rgb Bi = unshot_constant_ ? constant_b : B[i];
-            sum += (weights[start + i] * t.jacobian * F[i]) * (Bi - b_star);
+            sum += (weights[start + i] * jacobian * F[i]) * (Bi - b_star);
         }
     }
-    return sum;
 }
 
 Rgb IncrementIntegrator::shadow_integral(const SurfacePoint& p, double tolerance, double near_field,
@@ -389,26 +404,13 @@ Rgb IncrementIntegrator::pieces_value(const SurfacePoint& p,
     // The cell's n or n+1 stands for the pieces' pair (n_pieces, n_pieces + 1).
     const int np = options_.n_pieces > 0 ? options_.n_pieces + (n - options_.n) : n;
     const TriangleRule& rule = tri_rules_[np];
-    const Rgb constant_b = unshot_constant_ ? shooter_.unshot.coefficient(0, 0) : Rgb{};
     Rgb sum;
     for (const ConvexPolygon& piece : pieces)
         for (size_t k = 1; k + 1 < piece.size(); ++k) {
             const Vec2 a = piece[0], b = piece[k], c = piece[k + 1];
             const double jacobian = std::fabs(cross(b - a, c - a));  // twice the area
             if (jacobian <= 0) continue;
-            for (size_t q = 0; q < rule.points.size(); ++q) {
-                const Vec2 X = a + rule.points[q].x * (b - a) + rule.points[q].y * (c - a);
-                const double F =
-                    form_factor_kernel(p.position, p.normal, plane_.to_space(X), plane_.normal);
-                ++extra_evaluations_;
-                if (F == 0) continue;
-                Rgb B = constant_b;
-                if (!unshot_constant_) {
-                    const Vec2 uv = plane_.parameters(X);
-                    B = (*unshot_patches_)(uv.x, uv.y);
-                }
-                sum += (rule.weights[q] * jacobian * F) * (B - b_star_);
-            }
+            add_triangle_rule(p, a, b, c, jacobian, rule, nullptr, sum);  // (u, v) exactly
         }
     return sum;
 }

@@ -234,6 +234,12 @@ private:
     ShadowTriangleCorners triangle_corners(Vec2 a, Vec2 b, Vec2 c) const;
     /// The triangle rule of degree 2n - 2 (tri_rules_[n]) of F (B_h - b*) on the triangle.
     Rgb triangle_value(const SurfacePoint& p, const ShadowTriangleCorners& t, int n);
+    /// Adds w |ab x ac| F (B_h - b*) at each node of `rule` on the triangle (a, b, c) of the
+    /// shooter's plane to `sum`, node after node; B_h's (u, v) by two Newton steps from the
+    /// corners' when `corners` is given, else by the exact inverse of the bilinear map.
+    void add_triangle_rule(const SurfacePoint& p, Vec2 a, Vec2 b, Vec2 c, double jacobian,
+                           const TriangleRule& rule, const ShadowTriangleCorners* corners,
+                           Rgb& sum);
     /// int F (B_h - b*) over the shadowed part (shadow_regions_) to `tolerance`, adaptively
     /// over its fan triangles; the triangles kept are appended to *kept.
     Rgb shadow_integral(const SurfacePoint& p, double tolerance, double near_field,
