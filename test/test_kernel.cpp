@@ -195,11 +195,20 @@ TEST_CASE("kernel: the vectorised kernel gives form_factor_kernel's values to th
             Vec3 x{u(rng), u(rng), u(rng)};
             Vec3 n = random_unit(rng);
             switch (kind(rng)) {
-                case 0: x = p; break;                                  // the node at p
-                case 1: x = x - dot(x - p, n_p) * n_p; break;          // on p's tangent plane
-                case 2: n = normalize(cross(x - p, random_unit(rng))); break;  // grazing the node
-                case 3: x = p + std::pow(10.0, 12 * (u(rng) + 2) / 4 - 6) * random_unit(rng); break;
-                default: break;
+                case 0:  // the node at p
+                    x = p;
+                    break;
+                case 1:  // on p's tangent plane
+                    x = x - dot(x - p, n_p) * n_p;
+                    break;
+                case 2:  // p on the node's tangent plane
+                    n = normalize(cross(x - p, random_unit(rng)));
+                    break;
+                case 3:  // from 1e-6 to 1e6 away
+                    x = p + std::pow(10.0, 12 * (u(rng) + 2) / 4 - 6) * random_unit(rng);
+                    break;
+                default:
+                    break;
             }
             nodes.push_back({x, n});
         }

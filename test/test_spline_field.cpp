@@ -273,9 +273,10 @@ TEST_CASE("spline_field: coefficients, channels, scale", "[spline_field]") {
     }
 }
 
-TEST_CASE("spline_field: polynomial patches equal evaluate, and the vectorised Horner step is "
-          "the scalar one to the bit",
-          "[spline_field]") {
+TEST_CASE(
+    "spline_field: polynomial patches equal evaluate, and the vectorised Horner step is "
+    "the scalar one to the bit",
+    "[spline_field]") {
     // PolynomialPatches stores each knot cell's m x m tensor polynomial; its value is eq. (20)'s
     // up to rounding, at random points and on the cells' edges, for m = 2..5 and levels 0..3.
     std::mt19937 rng(11);

@@ -30,8 +30,12 @@ struct ShootingNodes {
 /// The six arrays of `count` nodes stored one after the other in `block` (x first, then y, z,
 /// nx, ny, nz), from node `start` on.
 inline ShootingNodes shooting_nodes(const double* block, int count, int start = 0) {
-    return {block + start,             block + count + start,     block + 2 * count + start,
-            block + 3 * count + start, block + 4 * count + start, block + 5 * count + start};
+    return {block + start,
+            block + count + start,
+            block + 2 * count + start,
+            block + 3 * count + start,
+            block + 4 * count + start,
+            block + 5 * count + start};
 }
 
 /// Appends the positions and normals of `count` points to `block` in shooting_nodes' layout.

@@ -219,8 +219,7 @@ void IncrementIntegrator::add_triangle_rule(const SurfacePoint& p, Vec2 a, Vec2 
                     const Vec2 node = points[start + i];
                     const Vec2 guess =
                         t.uv_a + node.x * (t.uv_b - t.uv_a) + node.y * (t.uv_c - t.uv_a);
-                    uv[i] =
-                        plane_.refine_parameters(X[i], plane_.refine_parameters(X[i], guess));
+                    uv[i] = plane_.refine_parameters(X[i], plane_.refine_parameters(X[i], guess));
                 }
             } else {
                 for (int i = 0; i < count; ++i)

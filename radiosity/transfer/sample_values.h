@@ -221,7 +221,7 @@ private:
     /// distance from p (its rule cannot be trusted there).
     bool too_near(const SurfacePoint& p, const QuadCell& cell, double near_field);
     void cell_image(const QuadCell& cell, ConvexPolygon& image) const;
-    ConvexPolygon image_;  // scratch of cell_value: the current cell's image
+    ConvexPolygon image_;                // scratch of cell_value: the current cell's image
     std::vector<Vec3> lambert_polygon_;  // scratch of visible_form_factor: a piece in space
     Rgb pieces_value(const SurfacePoint& p, const std::vector<ConvexPolygon>& pieces, int n);
     /// A triangle of the shooter's plane, the (u, v) of its corners (unless B_h is constant)
