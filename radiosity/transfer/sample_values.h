@@ -97,8 +97,9 @@ struct ShooterPoint {
 
 /// Bounds of an integrator's caches of shooter points (tensor cells, and pieces only the
 /// horizon cuts), beyond which each starts over: values never depend on them. DESIGN: 2^17
-/// and 2^16 points (10 and 5 MiB); 2^20 made the room peak at 195 MiB, 126 MiB of it these
-/// caches (docs/method.md, "Memory and threads").
+/// and 2^16 points (16 and 8 MiB with their nodes' arrays, 128 bytes a point; 10 and 5 MiB
+/// before the arrays); 2^20 made the room peak at 195 MiB, 126 MiB of it these caches
+/// (docs/method.md, "Memory and threads").
 constexpr size_t max_cached_points = size_t(1) << 17;
 constexpr size_t max_cached_horizon_points = size_t(1) << 16;
 /// The most one integrator's caches hold, in bytes (the memory estimate counts it per thread).
