@@ -162,13 +162,22 @@ Vec2 Polygon::to_local(Vec3 p) const {
     return {dot(d, axis_u_), dot(d, axis_v_)};
 }
 
+namespace {
+
+// Four corners' (u, v) blended at (s, t) of the unit square (corner 0 at (0, 0), then
+// counter-clockwise): uv_bilinear's, and uv_at's on a parallelogram's inline copy.
+Vec2 bilinear_blend(const Vec2* corner, double s, double t) {
+    return (1 - s) * (1 - t) * corner[0] + s * (1 - t) * corner[1] + s * t * corner[2] +
+           (1 - s) * t * corner[3];
+}
+
+}  // namespace
+
 Vec2 Polygon::uv_at(Vec3 p) const {
     if (parallelogram_) {
         const Vec3 d = p - origin_;
         const double s = dot(d, inverse_s_), t = dot(d, inverse_t_);
-        // uv_bilinear's blend, on the inline copy of the corners' (u, v).
-        return (1 - s) * (1 - t) * corner_uv_[0] + s * (1 - t) * corner_uv_[1] +
-               s * t * corner_uv_[2] + (1 - s) * t * corner_uv_[3];
+        return bilinear_blend(corner_uv_.data(), s, t);  // the inline copy of the corners
     }
     Vec2 q = to_local(p);
     if (n_vertices() == 3) {
@@ -189,8 +198,7 @@ Vec2 Polygon::uv_quad(Vec2 q) const {
 }
 
 Vec2 Polygon::uv_bilinear(double s, double t) const {
-    return (1 - s) * (1 - t) * uv_[0] + s * (1 - t) * uv_[1] + s * t * uv_[2] +
-           (1 - s) * t * uv_[3];
+    return bilinear_blend(uv_.data(), s, t);
 }
 
 Vec2 Polygon::uv_mean_value(Vec2 q) const {
