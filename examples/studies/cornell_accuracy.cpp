@@ -67,7 +67,7 @@ struct Setting {
     int min_depth = -1;     // receiver quadtree's minimum depth (-1: as given)
     int ambient_rays = -1;  // rays a point of the ambient gather (-1: as given)
 };
-// DESIGN: the two fast rungs keep the finest depth and stop early: the gathered ambient
+// DESIGN: the two fast rungs stop early (medium at the finest depth): the gathered ambient
 // correction and its final gather (docs/method.md) place the power left unshot about as well as
 // further shots would, and a coarse tree costs more in the shadows than the shots it saves.
 // Measured 2026-12-06 (2 threads): coarse (1e-2, 3, 1e-2) 2.81 / 23.52 % in 0.78 s became
@@ -77,15 +77,17 @@ struct Setting {
 // DESIGN: coarse is the paper's other order, m = 3, at depths 2..5 with 64 gather rays a point
 // (tolerance and stop 3e-2). Its quadratic pieces need one level more at the top than m = 4's
 // cubic ones (at min_depth 1 the green wall's level-1 cells follow the lamp's fall-off within
-// 3.9 %; at 2 within 0.4 %), and cost about half per sample. Measured 2026-12-07: 0.83 / 2.45 %
-// at the 16 points in 0.224 s a process (farm-bench, 11 pairs, against 0.391 s for (3e-2, 6,
-// 3e-2) with 96 rays and m = 4, which reads 0.84 / 1.88 %); at 63 random points against
-// 1M-path estimates 1.26 % mean against that setting's 1.42 % (docs/method.md). The previous
-// coarse, (5e-2, 6, 5e-2) at m = 4, read 1.29 / 6.83 %.
+// 3.9 %; at 2 within 0.4 %), and take 9 samples a leaf instead of 16. Measured 2026-12-07:
+// 0.83 / 2.45 % at the 16 points in 0.224 s a process (farm-bench, 11 pairs, against 0.391 s
+// for (3e-2, 6, 3e-2) with 96 rays and m = 4, which reads 0.84 / 1.88 %); at 63 random points
+// against 1M-path estimates 1.26 % mean against that setting's 1.42 % (docs/method.md). The
+// previous coarse, (5e-2, 6, 5e-2) at m = 4, read 1.29 / 6.83 %.
 const Setting ladder[] = {
-    {"coarse", 3e-2, 5, 3e-2, 3, 2, 64}, {"medium", 3e-2, 6, 3e-2},
+    {"coarse", 3e-2, 5, 3e-2, 3, 2, 64},
+    {"medium", 3e-2, 6, 3e-2},
     {"default", 0, 0, 0},  // the options as given (mbr render's defaults)
-    {"fine", 1e-3, 6, 1e-4},   {"finer", 3e-4, 7, 1e-4},
+    {"fine", 1e-3, 6, 1e-4},
+    {"finer", 3e-4, 7, 1e-4},
 };
 
 /// A reference point: where, and its radiosity.
