@@ -140,35 +140,118 @@ std::optional<ConvexSolid> make_solid(const std::vector<Polygon>& polygons,
         }
         return reach >= 1 - slack;
     };
-    Vec3 centre{0, 0, 0};
-    std::vector<std::array<Vec3, 2>> outline;  // directed as their face runs them
-    for (const DirectedEdge& e : single) {
-        if (covered(e)) continue;
-        outline.push_back({points[size_t(e.a)], points[size_t(e.b)]});
-        solid.missing_outline.push_back(index_of(e.a));
-        centre = centre + points[size_t(e.a)];
-    }
+    // The edges left are the openings' outlines: one closed loop each, joined through their
+    // shared vertices.
+    std::vector<DirectedEdge> outline;
+    for (const DirectedEdge& e : single)
+        if (!covered(e)) outline.push_back(e);
     if (outline.empty()) return solid;  // closed
-    // The missing face: the plane of the outline, which must support the solid.
-    centre = (1.0 / double(outline.size())) * centre;
-    Vec3 normal{0, 0, 0};
-    for (const auto& e : outline) normal = normal + cross(e[0] - centre, e[1] - centre);
-    if (!(length(normal) > 0)) return std::nullopt;
-    normal = normalize(normal);
-    Plane missing{normal, dot(normal, centre)};
-    for (const auto& e : outline)
-        if (std::fabs(missing.signed_distance(e[0])) > tol) return std::nullopt;
-    bool behind = false, in_front = false;
-    for (const Vec3& v : solid.vertices) {
-        const double d = missing.signed_distance(v);
-        if (d > tol) in_front = true;
-        if (d < -tol) behind = true;
+    std::unordered_map<int, int> loop_of;  // scene vertex id -> union-find node
+    std::vector<int> loop_parent;
+    auto node_of = [&](int id) {
+        const auto it = loop_of.emplace(id, int(loop_parent.size())).first;
+        if (it->second == int(loop_parent.size())) loop_parent.push_back(it->second);
+        return it->second;
+    };
+    for (const DirectedEdge& e : outline) {
+        const int a = find_root(loop_parent, node_of(e.a));
+        const int b = find_root(loop_parent, node_of(e.b));
+        loop_parent[size_t(a)] = b;
     }
-    if (behind == in_front) return std::nullopt;  // it cuts the solid, or the solid is flat
-    if (in_front) missing = Plane{-1.0 * normal, -missing.offset};
-    solid.open = true;
-    solid.missing = missing;
+    std::vector<int> roots;  // one per loop, in the order of their first edge
+    std::vector<std::vector<const DirectedEdge*>> loops;
+    for (const DirectedEdge& e : outline) {
+        const int root = find_root(loop_parent, node_of(e.a));
+        const auto it = std::find(roots.begin(), roots.end(), root);
+        if (it == roots.end()) {
+            roots.push_back(root);
+            loops.emplace_back();
+        }
+        loops[size_t(std::find(roots.begin(), roots.end(), root) - roots.begin())].push_back(&e);
+    }
+    if (loops.size() > size_t(max_solid_openings)) return std::nullopt;
+    for (const std::vector<const DirectedEdge*>& loop : loops) {
+        // The opening: the plane of its outline, which must support the solid.
+        Vec3 centre{0, 0, 0};
+        for (const DirectedEdge* e : loop) centre = centre + points[size_t(e->a)];
+        centre = (1.0 / double(loop.size())) * centre;
+        Vec3 normal{0, 0, 0};
+        for (const DirectedEdge* e : loop)
+            normal = normal + cross(points[size_t(e->a)] - centre, points[size_t(e->b)] - centre);
+        if (!(length(normal) > 0)) return std::nullopt;
+        normal = normalize(normal);
+        Plane plane{normal, dot(normal, centre)};
+        for (const DirectedEdge* e : loop)
+            if (std::fabs(plane.signed_distance(points[size_t(e->a)])) > tol) return std::nullopt;
+        bool behind = false, in_front = false;
+        for (const Vec3& v : solid.vertices) {
+            const double d = plane.signed_distance(v);
+            if (d > tol) in_front = true;
+            if (d < -tol) behind = true;
+        }
+        if (behind == in_front) return std::nullopt;  // it cuts the solid, or the solid is flat
+        if (in_front) plane = Plane{-1.0 * normal, -plane.offset};
+        SolidOpening opening{plane, {}};
+        for (const DirectedEdge* e : loop) opening.outline.push_back(index_of(e->a));
+        solid.openings.push_back(std::move(opening));
+    }
     return solid;
+}
+
+/// The sheet the faces form: a disk (one boundary loop, V - E + F = 1) whose faces meet along
+/// whole edges, each edge in at most two faces run opposite ways (the faces turned one way).
+std::optional<ConvexSheet> make_sheet(const std::vector<Polygon>& polygons,
+                                      const std::vector<int>& faces,
+                                      const std::vector<std::vector<int>>& corner_ids,
+                                      const std::vector<Vec3>& points) {
+    ConvexSheet sheet;
+    sheet.polygons = faces;
+    std::unordered_map<std::uint64_t, int> way;  // edge key -> a bit per direction run
+    std::unordered_map<int, int> next;           // boundary: vertex -> the next one
+    std::vector<int> ids;
+    Box3 box;
+    for (int f : faces) {
+        sheet.faces.push_back(polygons[size_t(f)].plane());
+        box.extend(polygons[size_t(f)].bounds());
+        const std::vector<int>& c = corner_ids[size_t(f)];
+        ids.insert(ids.end(), c.begin(), c.end());
+        for (size_t k = 0; k < c.size(); ++k) {
+            const int a = c[k], b = c[(k + 1) % c.size()];
+            int& w = way[edge_key(a, b)];
+            const int d = a < b ? 1 : 2;
+            if (w & d) return std::nullopt;  // an edge run twice the same way
+            w |= d;
+        }
+    }
+    sheet.diameter = length(box.extent());
+    std::sort(ids.begin(), ids.end());
+    ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+    for (int id : ids) sheet.vertices.push_back(points[size_t(id)]);
+    long n_boundary = 0;
+    for (int f : faces) {
+        const std::vector<int>& c = corner_ids[size_t(f)];
+        for (size_t k = 0; k < c.size(); ++k) {
+            const int a = c[k], b = c[(k + 1) % c.size()];
+            if (way[edge_key(a, b)] != 3) {                           // in this face only
+                if (!next.emplace(a, b).second) return std::nullopt;  // a pinched boundary
+                ++n_boundary;
+            }
+        }
+    }
+    if (n_boundary < 3) return std::nullopt;
+    const long n_edges = long(way.size()), n_vertices = long(ids.size());
+    if (n_vertices - n_edges + long(faces.size()) != 1) return std::nullopt;  // not a disk
+    // One loop through every boundary edge.
+    const int first = next.begin()->first;
+    int at = first;
+    do {
+        sheet.boundary.push_back(points[size_t(at)]);
+        const auto it = next.find(at);
+        if (it == next.end()) return std::nullopt;
+        at = it->second;
+    } while (at != first && long(sheet.boundary.size()) <= n_boundary);
+    if (long(sheet.boundary.size()) != n_boundary) return std::nullopt;
+    return sheet;
 }
 
 }  // namespace
@@ -230,6 +313,24 @@ ConvexSolids find_convex_solids(const std::vector<Polygon>& polygons) {
         for (int f : faces) out.solid_of[size_t(f)] = int(out.solids.size());
         out.solids.push_back(std::move(*solid));
     }
+    // The sheets: the other polygons by surface, in the order of their first polygon.
+    std::unordered_map<int, std::vector<int>> by_surface;
+    std::vector<int> surfaces;
+    for (int f = 0; f < n; ++f) {
+        if (out.solid_of[size_t(f)] >= 0) continue;
+        std::vector<int>& list = by_surface[polygons[size_t(f)].surface()];
+        if (list.empty()) surfaces.push_back(polygons[size_t(f)].surface());
+        list.push_back(f);
+    }
+    out.sheet_of.assign(size_t(n), -1);
+    for (int surface : surfaces) {
+        const std::vector<int>& faces = by_surface[surface];
+        if (faces.size() < 2 || faces.size() > size_t(max_sheet_faces)) continue;
+        std::optional<ConvexSheet> sheet = make_sheet(polygons, faces, corner_ids, points);
+        if (!sheet) continue;
+        for (int f : faces) out.sheet_of[size_t(f)] = int(out.sheets.size());
+        out.sheets.push_back(std::move(*sheet));
+    }
     return out;
 }
 
@@ -238,24 +339,52 @@ void attach_solids(OcclusionContext& context, const ConvexSolids& solids) {
     context.solid_ids.clear();
     context.loose.clear();
     const std::vector<Polygon>& polys = context.octree->polygons();
-    auto usable = [&](int s) {
-        for (int id : solids.solids[size_t(s)].polygons) {
-            const int surface = polys[size_t(id)].surface();
-            if (surface == context.shooter_surface || surface == context.receiver_surface)
-                return false;
+    // How a solid stands to the pair: apart from it (usable as one caster), holding one of the
+    // pair's surfaces as one of its face planes (it casts no shadow between them: every segment
+    // from a point of that face to a point in front of it lies outside the solid, which is
+    // behind the face's plane, and the pair's points see each other only in front), or holding
+    // them otherwise (its faces stay loose).
+    enum class Stand { apart, on_face, other };
+    auto stand = [&](int s) {
+        const ConvexSolid& solid = solids.solids[size_t(s)];
+        Stand out = Stand::apart;
+        for (int surface : {context.shooter_surface, context.receiver_surface}) {
+            const Plane* face = nullptr;
+            for (size_t k = 0; k < solid.polygons.size(); ++k) {
+                if (polys[size_t(solid.polygons[k])].surface() != surface) continue;
+                // DESIGN: the same plane to 1e-9 of the solid's size, as make_solid's faces.
+                const Plane& plane = solid.faces[k];
+                if (!face) {
+                    face = &plane;
+                    out = out == Stand::apart ? Stand::on_face : out;
+                } else if (dot(plane.normal, face->normal) < 1 - 1e-9 ||
+                           std::fabs(plane.offset - face->offset) > 1e-9 * solid.diameter) {
+                    return Stand::other;  // a curved surface of the solid's (a ball)
+                }
+            }
         }
-        return true;
+        return out;
     };
+    std::vector<int> dropped;  // solids on one of the pair's faces
     for (int id : context.candidates) {
         const int s = id < int(solids.solid_of.size()) ? solids.solid_of[size_t(id)] : -1;
-        const bool taken = s >= 0 && std::find(context.solid_ids.begin(), context.solid_ids.end(),
-                                               s) != context.solid_ids.end();
-        if (taken) continue;
-        if (s >= 0 && usable(s))
+        if (s >= 0 && (std::find(context.solid_ids.begin(), context.solid_ids.end(), s) !=
+                           context.solid_ids.end() ||
+                       std::find(dropped.begin(), dropped.end(), s) != dropped.end()))
+            continue;  // taken
+        const Stand st = s >= 0 ? stand(s) : Stand::other;
+        if (st == Stand::apart)
             context.solid_ids.push_back(s);
+        else if (st == Stand::on_face)
+            dropped.push_back(s);
         else
             context.loose.push_back(id);
     }
+    std::vector<int> surfaces;
+    for (int id : context.loose) surfaces.push_back(polys[size_t(id)].surface());
+    std::sort(surfaces.begin(), surfaces.end());
+    context.loose_surfaces =
+        static_cast<int>(std::unique(surfaces.begin(), surfaces.end()) - surfaces.begin());
 }
 
 }  // namespace mbr

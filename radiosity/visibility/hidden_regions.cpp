@@ -150,22 +150,33 @@ double lowest_below(const Polygon& polygon, const Plane& plane) {
     return least;
 }
 
-/// Whether p lies inside the convex solid grown by `by` (behind every face's plane, and the
-/// missing face's).
+/// Whether p lies inside the convex solid grown by `by` (behind every face's plane, and every
+/// opening's).
 bool inside_solid(const ConvexSolid& solid, Vec3 p, double by) {
     for (const Plane& f : solid.faces)
         if (f.signed_distance(p) > by) return false;
-    return !solid.open || solid.missing.signed_distance(p) <= by;
+    for (const SolidOpening& o : solid.openings)
+        if (o.plane.signed_distance(p) > by) return false;
+    return true;
 }
 
 /// Whether a point of `receiver` may see the back of one of the solid's faces: the polygon
-/// reaches the outer side of an open solid's missing face (or its plane), or it is not wholly
+/// reaches the outer side of an open solid's opening (or its plane), or it is not wholly
 /// outside any of the solid's faces' planes (it may enter the solid).
 bool may_enter(const ConvexSolid& solid, const Polygon& receiver, double slack) {
-    if (solid.open && highest_above(receiver, solid.missing) > -slack) return true;
+    for (const SolidOpening& o : solid.openings)
+        if (highest_above(receiver, o.plane) > -slack) return true;
     for (const Plane& f : solid.faces)
         if (lowest_below(receiver, f) > slack) return false;
-    return true;  // (an open solid's missing plane: every vertex is inside it here)
+    return true;  // (an open solid's openings: every vertex is inside their planes here)
+}
+
+/// Whether p lies in front of one of the solid's openings' planes, or behind them all by less
+/// than `by` (where the solid's back faces may show).
+bool near_an_opening(const ConvexSolid& solid, Vec3 p, double by) {
+    for (const SolidOpening& o : solid.openings)
+        if (o.plane.signed_distance(p) >= -by) return true;
+    return false;
 }
 
 Box3 grown_box(Box3 box, double by) {
@@ -210,8 +221,8 @@ HiddenMask find_hidden(const Surface& surface, int surface_id, const Octree& oct
             if (k >= 0) {
                 const ConvexSolid& solid = contacts->solids.solids[size_t(k)];
                 if (inside_solid(solid, p, texel + slack)) return true;
-                // Outside, only an open solid's back faces show, through the missing face.
-                if (!solid.open || solid.missing.signed_distance(p) < -(texel + slack)) continue;
+                // Outside, only an open solid's back faces show, through an opening.
+                if (!near_an_opening(solid, p, texel + slack)) continue;
             }
             const double reach = contact_reach(occluder) + texel + slack;
             const Box3 b = occluder.bounds();

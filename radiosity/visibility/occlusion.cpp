@@ -295,12 +295,7 @@ void group_surface_boxes(OcclusionContext& context) {
 
 int shadow_casters(const OcclusionContext& context) {
     if (!context.solids) return static_cast<int>(context.surface_boxes.size());
-    std::vector<int> surfaces;
-    const std::vector<Polygon>& polys = context.octree->polygons();
-    for (int id : context.loose) surfaces.push_back(polys[size_t(id)].surface());
-    std::sort(surfaces.begin(), surfaces.end());
-    const auto distinct = std::unique(surfaces.begin(), surfaces.end()) - surfaces.begin();
-    return static_cast<int>(context.solid_ids.size()) + static_cast<int>(distinct);
+    return static_cast<int>(context.solid_ids.size()) + context.loose_surfaces;
 }
 
 namespace {

@@ -36,6 +36,7 @@ struct OcclusionContext {
     const ConvexSolids* solids = nullptr;
     std::vector<int> solid_ids;
     std::vector<int> loose;
+    int loose_surfaces = 0;  // the surfaces of the loose polygons (attach_solids)
     /// True when nothing can come between the two surfaces.
     bool clear() const { return candidates.empty(); }
 };

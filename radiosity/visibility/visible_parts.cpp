@@ -5,7 +5,9 @@
 #include "radiosity/visibility/visible_parts.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <limits>
 
 #include "math/check.h"
 
@@ -245,18 +247,100 @@ ConvexPolygon project_occluder(const ShooterPlane& plane, Vec3 p, double h_p,
     return clip_to_shooter(plane, shadow);
 }
 
+/// Points and edges whose convex hull holds an occluder (a polygon's corners and sides, a box's
+/// corners and edges).
+struct Outline {
+    std::vector<Vec3> points;
+    std::vector<std::array<int, 2>> edges;
+    void add_polygon(const std::vector<Vec3>& corners) {
+        const int first = static_cast<int>(points.size()), n = static_cast<int>(corners.size());
+        points.insert(points.end(), corners.begin(), corners.end());
+        for (int k = 0; k < n; ++k) edges.push_back({first + k, first + (k + 1) % n});
+    }
+    void add_box(const Box3& b) {
+        const int first = static_cast<int>(points.size());
+        for (int c = 0; c < 8; ++c)
+            points.push_back(
+                {(c & 1) ? b.hi.x : b.lo.x, (c & 2) ? b.hi.y : b.lo.y, (c & 4) ? b.hi.z : b.lo.z});
+        for (int c = 0; c < 8; ++c)
+            for (int bit : {1, 2, 4})
+                if (!(c & bit)) edges.push_back({first + c, first + (c | bit)});
+    }
+};
+
+/// Whether every segment from p to a point of the shooter that meets the convex hull of the
+/// outline ends in one of the `shadows` (convex, counter-clockwise): the hull's part between the
+/// shooter's plane and p (its points in that slab and its edges' crossings of it), projected
+/// from p and clipped to the shooter, lies in one shadow.
+/// DESIGN: inside within 1e-9 of the shooter's size, as the shadows' own edges are rounded.
+bool shadow_covered(const ShooterPlane& plane, Vec3 p, double h_p, const Outline& outline,
+                    const std::vector<ConvexPolygon>& shadows) {
+    const double h_max = slab_top(h_p);
+    std::vector<double> h(outline.points.size());
+    std::vector<Vec3> slab;
+    for (size_t k = 0; k < h.size(); ++k) {
+        h[k] = dot(plane.normal, outline.points[k] - plane.origin);
+        if (h[k] >= 0 && h[k] <= h_max) slab.push_back(outline.points[k]);
+    }
+    for (const std::array<int, 2>& e : outline.edges)
+        push_slab_crossings(outline.points[size_t(e[0])], outline.points[size_t(e[1])],
+                            h[size_t(e[0])], h[size_t(e[1])], h_max, slab);
+    if (slab.empty()) return true;  // wholly outside the slab: it meets no segment
+    std::vector<Vec2> projected;
+    for (const Vec3& x : slab) projected.push_back(project_from(plane, p, h_p, x));
+    ConvexPolygon hull = convex_hull(projected);
+    if (hull.size() >= 3) {
+        hull = intersect(hull, plane.outline);
+        if (hull.empty()) return true;  // it hides none of the shooter
+    } else {
+        return false;  // (a point or a segment: not worth deciding)
+    }
+    const double slack = 1e-9 * plane.size;
+    for (const ConvexPolygon& shadow : shadows) {
+        const size_t n = shadow.size();
+        bool inside = n >= 3;
+        for (size_t e = 0; e < n && inside; ++e) {
+            const Vec2 a = shadow[e], b = shadow[(e + 1) % n];
+            const Vec2 d = b - a;
+            const double len = std::sqrt(dot(d, d));
+            for (const Vec2& q : hull)
+                if (cross(d, q - a) < -slack * len) {
+                    inside = false;
+                    break;
+                }
+        }
+        if (inside) return true;
+    }
+    return false;
+}
+
+/// Whether every corner lies behind the plane through p with normal n_p, or on it (within
+/// `tol`): nothing there comes between p and a point in front of p.
+bool behind_p(Vec3 p, Vec3 n_p, const std::vector<Vec3>& corners, double tol) {
+    for (const Vec3& v : corners)
+        if (dot(n_p, v - p) > tol) return false;
+    return true;
+}
+
 }  // namespace
 
 std::optional<ConvexPolygon> solid_shadow(const ShooterPlane& plane, Vec3 p, double h_p,
-                                          const ConvexSolid& solid) {
+                                          const ConvexSolid& solid, bool openings_covered,
+                                          SolidRefusal* why) {
+    if (why) *why = SolidRefusal::none;
     // The rule of convex_solids.h holds when p lies outside K by more than 1e-6 of the longest
     // ray to the shooter: a ray entering K within 1e-7 h_p below p's height (where the faces
     // are cut off) would then have to run 1e7 times that margin before reaching the shooter.
     double reach = 0;
     for (const Vec2& c : plane.outline) reach = std::max(reach, length(plane.to_space(c) - p));
-    double outside = solid.open ? solid.missing.signed_distance(p) : -HUGE_VAL;
+    double outside = -HUGE_VAL;
+    for (const SolidOpening& o : solid.openings)
+        outside = std::max(outside, o.plane.signed_distance(p));
     for (const Plane& face : solid.faces) outside = std::max(outside, face.signed_distance(p));
-    if (!(outside > 1e-6 * reach)) return std::nullopt;
+    if (!(outside > 1e-6 * reach)) {
+        if (why) *why = SolidRefusal::inside;
+        return std::nullopt;
+    }
     const double h_max = slab_top(h_p);
     std::vector<double> h(solid.vertices.size());
     double lowest = HUGE_VAL, highest = -HUGE_VAL;
@@ -266,15 +350,28 @@ std::optional<ConvexPolygon> solid_shadow(const ShooterPlane& plane, Vec3 p, dou
         highest = std::max(highest, h[k]);
     }
     if (highest < 0 || lowest > h_max) return ConvexPolygon{};  // wholly outside the slab
-    // A missing face that p sees, on a solid that reaches the shooter's plane: a ray entering
-    // through it and ending on the shooter inside K crosses no face, unless that face lies in
-    // the shooter's plane itself (a block standing on its shooter).
-    if (solid.open && solid.missing.signed_distance(p) > 0) {
-        const double tol = 1e-9 * (plane.size + solid.diameter);
-        if (lowest <= tol)
-            for (int k : solid.missing_outline)
-                if (std::fabs(h[size_t(k)]) > tol) return std::nullopt;
-    }
+    // An opening that p sees: a ray entering through it crosses no face when it ends on the
+    // shooter inside K (K reaches the shooter's plane), unless that opening lies in the
+    // shooter's plane itself (a block standing on its shooter), or when it leaves K through the
+    // other opening towards a shooter that reaches in front of that opening's plane.
+    const double tol = 1e-9 * (plane.size + solid.diameter);
+    if (!openings_covered)
+        for (const SolidOpening& seen : solid.openings) {
+            if (!(seen.plane.signed_distance(p) > 0)) continue;
+            bool passes = false;
+            if (lowest <= tol)
+                for (int k : seen.outline)
+                    if (std::fabs(h[size_t(k)]) > tol) passes = true;
+            for (const SolidOpening& other : solid.openings) {
+                if (&other == &seen) continue;
+                for (const Vec2& c : plane.outline)
+                    if (other.plane.signed_distance(plane.to_space(c)) > tol) passes = true;
+            }
+            if (passes) {
+                if (why) *why = SolidRefusal::opening;
+                return std::nullopt;
+            }
+        }
     std::vector<Vec3> slab;
     slab.reserve(h.size() + 8);  // the corners in the slab and a few edges' crossings
     for (size_t k = 0; k < h.size(); ++k)
@@ -288,6 +385,43 @@ std::optional<ConvexPolygon> solid_shadow(const ShooterPlane& plane, Vec3 p, dou
     for (const Vec3& x : slab) projected.push_back(project_from(plane, p, h_p, x));
     const ConvexPolygon hull = convex_hull(std::move(projected));
     if (hull.empty()) return hull;  // seen edge-on: it hides nothing
+    return clip_to_shooter(plane, hull);
+}
+
+std::optional<ConvexPolygon> sheet_shadow(const ShooterPlane& plane, Vec3 p, double h_p,
+                                          const ConvexSheet& sheet) {
+    // Every corner strictly between the shooter's plane and p (in the slab), and p on the same
+    // side of every face, by more than 1e-9 of the sizes (a face seen edge-on could fold the
+    // projection).
+    const double h_max = slab_top(h_p);
+    for (const Vec3& v : sheet.vertices) {
+        const double h = dot(plane.normal, v - plane.origin);
+        if (!(h >= 0 && h <= h_max)) return std::nullopt;
+    }
+    const double tol = 1e-9 * (plane.size + sheet.diameter + h_p);
+    int front = 0, behind = 0;
+    for (const Plane& face : sheet.faces) {
+        const double d = face.signed_distance(p);
+        if (d > tol)
+            ++front;
+        else if (d < -tol)
+            ++behind;
+        else
+            return std::nullopt;
+    }
+    if (front > 0 && behind > 0) return std::nullopt;
+    // The projected boundary encloses the projection; it is the shadow when it is convex: its
+    // area (the projected faces' areas, each once) equals its hull's.
+    std::vector<Vec2> loop;
+    loop.reserve(sheet.boundary.size());
+    for (const Vec3& x : sheet.boundary) loop.push_back(project_from(plane, p, h_p, x));
+    double area = 0;
+    for (size_t k = 0; k < loop.size(); ++k) area += cross(loop[k], loop[(k + 1) % loop.size()]);
+    area = 0.5 * std::fabs(area);
+    ConvexPolygon hull = convex_hull(std::move(loop));
+    if (hull.size() < 3) return ConvexPolygon{};  // seen edge-on: it hides nothing
+    // DESIGN: within 1e-9 of the hull's area, as convex_union's test.
+    if (std::fabs(signed_area(hull) - area) > 1e-9 * signed_area(hull)) return std::nullopt;
     return clip_to_shooter(plane, hull);
 }
 
@@ -354,51 +488,175 @@ BlockedView blocked_view(const ShooterPlane& plane, Vec3 p, Vec3 n_p,
     const double h_p = dot(plane.normal, p - plane.origin);  // height of p above the plane
     if (!context || context->candidates.empty() || h_p <= 0) return view;
     const std::vector<Polygon>& polys = context->octree->polygons();
-    // What casts a shadow at p: whole convex solids (one silhouette each) and loose polygons.
+    // What casts a shadow at p: whole convex solids (one silhouette each), convex sheets (one
+    // polygon each) and loose polygons.
     // DESIGN: exact_limit counts these casters, not polygons: a box standing in the way is one
     // shadow, not six (scene_scaling's room of 17 blocks, 102 faces, took one ray per
     // quadrature node at every receiving point when the faces were counted).
+    // DESIGN: a caster within 1e-9 of the sizes of p's tangent plane, or behind it, hides
+    // nothing from p (the pair's points see each other only in front): a face beside the
+    // receiver in its plane, the stool's seat above the point under it.
+    const double behind_tolerance = 1e-9 * (plane.size + length(p - plane.origin));
     std::vector<int> near_p;
     ShadowCasters near;  // near_p's casters
     const std::vector<int>* occluders = &context->candidates;
     const std::vector<int>* solid_ids = &context->solid_ids;
     const std::vector<int>* loose = context->solids ? &context->loose : &context->candidates;
-    auto casters = [&] { return static_cast<int>(solid_ids->size() + loose->size()); };
-    if (casters() > exact_limit) {
-        // Many for the pair (a big scene): only the occluders that meet the pyramid from p to
-        // the shooter count for p, found with the octree, by their solids as the pair's are
-        // (attach_solids: a solid of the pair's stands for all its faces); still too many: rays
-        // instead of projection.
-        // (The grouping stops once the casters pass the limit: rays then, whatever the rest.)
+    auto use_rays = [&]() {
+        view.use_rays = true;
+        view.shadows.clear();
+        view.occluders = near_p.empty() ? context->candidates : std::move(near_p);
+        return view;
+    };
+    // DESIGN: the pair's casters are counted by surface, as shadow_casters counts them (a cloth
+    // of 1,152 triangles is one surface): per point the octree's list of the occluders toward p
+    // cost more than projecting the pair's few casters (the room's floor shot with exact
+    // visibility: 20 % of its time in occluders_toward and 8 % sorting its lists).
+    const int pair_casters =
+        static_cast<int>(solid_ids->size()) +
+        (context->solids ? context->loose_surfaces : static_cast<int>(loose->size()));
+    // Many for the pair (a big scene), or more than the limit at p from the pair's lists: only
+    // the occluders that meet the pyramid from p to the shooter count for p, found with the
+    // octree, by their solids as the pair's are (attach_solids: a solid of the pair's stands
+    // for all its faces); more solids than the limit: rays instead of projection.
+    auto toward_p = [&]() {
         near_p = occluders_toward(*context, plane, p);
-        near = casters_among(*context, near_p, exact_limit);
+        near = casters_among(*context, near_p, std::numeric_limits<int>::max());
         occluders = &near_p;
         solid_ids = &near.solids;
         loose = &near.loose;
-        if (casters() > exact_limit) {
-            view.use_rays = true;
-            view.occluders = std::move(near_p);
-            return view;
-        }
-    }
-    auto add_shadow = [&view](ConvexPolygon shadow) {
-        if (!shadow.empty()) view.shadows.push_back(std::move(shadow));
+        return static_cast<int>(solid_ids->size()) <= exact_limit;
     };
-    auto add_face = [&](int id) {
-        add_shadow(project_occluder(plane, p, h_p, polys[size_t(id)].vertices()));
-    };
-    // Each convex solid by its silhouette (convex_solids.h), or where its rule does not hold at
-    // p, by those of its faces that are occluders.
-    for (int s : *solid_ids) {
-        const ConvexSolid& solid = context->solids->solids[size_t(s)];
-        if (std::optional<ConvexPolygon> shadow = solid_shadow(plane, p, h_p, solid)) {
-            add_shadow(std::move(*shadow));
-            continue;
+    if (pair_casters > exact_limit && !toward_p()) return use_rays();
+    const bool may_narrow = occluders == &context->candidates &&
+                            static_cast<int>(solid_ids->size() + loose->size()) > exact_limit;
+    std::vector<std::vector<ConvexPolygon>> slots;
+    for (int attempt = 0;; ++attempt) {
+        // Each caster's shadows in a slot of its own, so that they enter the view in the casters'
+        // order whatever is decided last (the solids', then the loose polygons' by polygon).
+        const size_t n_solids = solid_ids->size();
+        slots.assign(n_solids + loose->size(), {});
+        auto add_shadow = [&slots](size_t slot, ConvexPolygon shadow) {
+            if (!shadow.empty()) slots[slot].push_back(std::move(shadow));
+        };
+        auto add_faces = [&](size_t slot, const ConvexSolid& solid) {
+            for (int id : solid.polygons)
+                if (std::binary_search(occluders->begin(), occluders->end(), id))
+                    add_shadow(slot, project_occluder(plane, p, h_p, polys[size_t(id)].vertices()));
+        };
+        // Each convex solid by its silhouette (convex_solids.h); where its rule does not hold at p,
+        // by those of its faces that are occluders, unless only an opening refused it (decided
+        // below, once the other casters' shadows are known).
+        std::vector<size_t> seen_openings;  // slots of solids refused for an opening p sees
+        int n_casters = 0;
+        for (size_t k = 0; k < n_solids; ++k) {
+            const ConvexSolid& solid = context->solids->solids[size_t((*solid_ids)[k])];
+            if (behind_p(p, n_p, solid.vertices, behind_tolerance)) continue;
+            ++n_casters;
+            SolidRefusal why = SolidRefusal::none;
+            if (std::optional<ConvexPolygon> shadow =
+                    solid_shadow(plane, p, h_p, solid, false, &why))
+                add_shadow(k, std::move(*shadow));
+            else if (why == SolidRefusal::opening)
+                seen_openings.push_back(k);
+            else
+                add_faces(k, solid);
         }
-        for (int id : solid.polygons)
-            if (std::binary_search(occluders->begin(), occluders->end(), id)) add_face(id);
+        // The loose polygons: a convex sheet's as one polygon (in the slot of its first), the
+        // others one by one. Beyond exact_limit, the polygons of a surface whose bounding box's
+        // shadow lies inside a solid's or a sheet's are dropped (a cloth lying on a table, seen
+        // past the table), and so is a lone polygon whose shadow does.
+        const ConvexSolids* groups = context->solids;
+        std::vector<int> sheets_done, sheets_refused;
+        std::vector<size_t> singles;  // slots of loose polygons projected one by one
+        for (size_t k = 0; k < loose->size(); ++k) {
+            const int id = (*loose)[k];
+            const int sheet = groups ? groups->sheet_of[size_t(id)] : -1;
+            if (sheet >= 0 && std::find(sheets_refused.begin(), sheets_refused.end(), sheet) ==
+                                  sheets_refused.end()) {
+                if (std::find(sheets_done.begin(), sheets_done.end(), sheet) != sheets_done.end())
+                    continue;
+                const ConvexSheet& sh = groups->sheets[size_t(sheet)];
+                if (behind_p(p, n_p, sh.vertices, behind_tolerance)) {
+                    sheets_done.push_back(sheet);
+                    continue;
+                }
+                if (std::optional<ConvexPolygon> shadow = sheet_shadow(plane, p, h_p, sh)) {
+                    sheets_done.push_back(sheet);
+                    ++n_casters;
+                    add_shadow(n_solids + k, std::move(*shadow));
+                    continue;
+                }
+                sheets_refused.push_back(sheet);
+            }
+            if (behind_p(p, n_p, polys[size_t(id)].vertices(), behind_tolerance)) continue;
+            singles.push_back(k);
+        }
+        if (n_casters + static_cast<int>(singles.size()) > exact_limit) {
+            std::vector<ConvexPolygon> cover;  // the solids' and sheets' shadows so far
+            for (const std::vector<ConvexPolygon>& slot : slots)
+                cover.insert(cover.end(), slot.begin(), slot.end());
+            std::vector<size_t> kept;
+            for (size_t a = 0; a < singles.size();) {
+                // The run of loose polygons of one surface (the list is by polygon, and a surface's
+                // polygons are consecutive in the octree's list).
+                const int surface = polys[size_t((*loose)[singles[a]])].surface();
+                size_t b = a;
+                Box3 bounds;
+                while (b < singles.size() &&
+                       polys[size_t((*loose)[singles[b]])].surface() == surface)
+                    bounds.extend(polys[size_t((*loose)[singles[b++]])].bounds());
+                Outline hull_of;
+                if (b - a == 1)
+                    hull_of.add_polygon(polys[size_t((*loose)[singles[a]])].vertices());
+                else
+                    hull_of.add_box(bounds);
+                if (!shadow_covered(plane, p, h_p, hull_of, cover))
+                    for (size_t c = a; c < b; ++c) kept.push_back(singles[c]);
+                a = b;
+            }
+            singles = std::move(kept);
+        }
+        n_casters += static_cast<int>(singles.size());
+        if (n_casters > exact_limit) {
+            if (attempt == 0 && may_narrow && toward_p()) continue;  // the pair's were too many
+            return use_rays();
+        }
+        for (size_t k : singles)
+            add_shadow(n_solids + k,
+                       project_occluder(plane, p, h_p, polys[size_t((*loose)[k])].vertices()));
+        // The solids refused for an opening: their silhouettes where every ray through each opening
+        // p sees is blocked by another caster (its shadow holds the opening's: a table leg's top
+        // under the table), else their faces.
+        if (!seen_openings.empty()) {
+            std::vector<ConvexPolygon> cover;
+            for (size_t slot = 0; slot < slots.size(); ++slot)
+                if (std::find(seen_openings.begin(), seen_openings.end(), slot) ==
+                    seen_openings.end())
+                    cover.insert(cover.end(), slots[slot].begin(), slots[slot].end());
+            for (size_t k : seen_openings) {
+                const ConvexSolid& solid = context->solids->solids[size_t((*solid_ids)[k])];
+                bool covered = true;
+                for (const SolidOpening& o : solid.openings) {
+                    if (!(o.plane.signed_distance(p) > 0)) continue;
+                    std::vector<Vec3> corners;
+                    for (int v : o.outline) corners.push_back(solid.vertices[size_t(v)]);
+                    Outline opening;
+                    opening.add_polygon(corners);
+                    covered = covered && shadow_covered(plane, p, h_p, opening, cover);
+                }
+                std::optional<ConvexPolygon> shadow;
+                if (covered) shadow = solid_shadow(plane, p, h_p, solid, true);
+                if (shadow)
+                    add_shadow(k, std::move(*shadow));
+                else
+                    add_faces(k, solid);
+            }
+        }
+        break;
     }
-    for (int id : *loose) add_face(id);
+    for (std::vector<ConvexPolygon>& slot : slots)
+        for (ConvexPolygon& shadow : slot) view.shadows.push_back(std::move(shadow));
     merge_shadows(view.shadows);
     // DESIGN: vertices within 1e-10 of the shooter's size of the line through their neighbours
     // are removed (changing a shadow's area by about 1e-10 of the shooter's). Clipping and the

@@ -112,15 +112,30 @@ int casters_toward(const OcclusionContext& context, const ShooterPlane& plane, V
 BlockedView blocked_view(const ShooterPlane& plane, Vec3 p, Vec3 n_p,
                          const OcclusionContext* context, const Plane* receiver_plane = nullptr);
 
+/// Why solid_shadow gives no silhouette: p within the solid, or an opening p sees that rays
+/// pass through (see convex_solids.h).
+enum class SolidRefusal { none, inside, opening };
+
 /// The shadow of a convex solid (convex_solids.h) on a planar shooter seen from p, at height
 /// h_p > 0 above its plane: the convex hull of the central projections of its corners and of
 /// its edges' crossings with the slab that each face is cut to (as blocked_view cuts them),
 /// clipped to the shooter's outline; empty when it hides nothing. Nothing (std::nullopt) where
-/// the solid's rule does not hold at p: p within 1e-6 of the longest ray's length of the solid,
-/// or a missing face that p sees on a solid reaching the shooter's plane (then the faces are
-/// projected one by one).
+/// the solid's rule does not hold at p (why says which, when given): p within 1e-6 of the
+/// longest ray's length of the solid, or an opening that p sees through which a ray reaches the
+/// shooter (it ends on the shooter inside a solid that reaches the shooter's plane, or leaves
+/// through the other opening), unless openings_covered: the caller has found every ray through
+/// the openings p sees blocked by other casters (blocked_view), and the union is the same.
 std::optional<ConvexPolygon> solid_shadow(const ShooterPlane& plane, Vec3 p, double h_p,
-                                          const ConvexSolid& solid);
+                                          const ConvexSolid& solid, bool openings_covered = false,
+                                          SolidRefusal* why = nullptr);
+
+/// The shadow of a sheet (convex_solids.h) on a planar shooter seen from p, at height h_p > 0
+/// above its plane: the projection of its boundary loop, when p sees every face from the same
+/// side, every corner lies between the shooter's plane and p, and the projected loop is convex
+/// (its area equals its hull's), clipped to the shooter's outline; empty when it hides nothing.
+/// Nothing (std::nullopt) where that does not hold (then its faces are projected one by one).
+std::optional<ConvexPolygon> sheet_shadow(const ShooterPlane& plane, Vec3 p, double h_p,
+                                          const ConvexSheet& sheet);
 
 /// The plane of a planar quad (Newell's normal through the corners' mean; only when its corners
 /// lie on it to rounding) or a disk, oriented by its front; nothing for other surfaces.
