@@ -562,7 +562,7 @@ BlockedView blocked_view(const ShooterPlane& plane, Vec3 p, Vec3 n_p,
             else
                 add_faces(k, solid);
         }
-        // The loose polygons: a convex sheet's as one polygon (in the slot of its first), the
+        // The loose polygons: a sheet's as one polygon (in the slot of its first), the
         // others one by one. Beyond exact_limit, the polygons of a surface whose bounding box's
         // shadow lies inside a solid's or a sheet's are dropped (a cloth lying on a table, seen
         // past the table), and so is a lone polygon whose shadow does.
