@@ -225,6 +225,18 @@ bool contains(const ConvexPolygon& polygon, Vec2 x) {
     return true;
 }
 
+bool contains(const ConvexPolygon& polygon, Vec2 x, double slack) {
+    const size_t n = polygon.size();
+    if (n < 3) return false;
+    for (size_t i = 0; i < n; ++i) {
+        const Vec2 d = polygon[(i + 1) % n] - polygon[i];
+        // left_of's value is the distance from the edge's line times the edge's length.
+        if (left_of(polygon[i], polygon[(i + 1) % n]).value(x) < -slack * std::sqrt(dot(d, d)))
+            return false;
+    }
+    return true;
+}
+
 Vec2 inverse_bilinear(Vec2 q0, Vec2 q1, Vec2 q2, Vec2 q3, Vec2 q) {
     // P(s,t) = q0 + s e + t f + s t g. Eliminating s from q - q0 - t f = s (e + t g) leaves
     // k2 t^2 + k1 t + k0 = 0 (as in Quilez's inverse bilinear interpolation).

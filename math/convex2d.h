@@ -84,6 +84,8 @@ Overlap classify(const ConvexPolygon& a, const ConvexPolygon& b);
 
 /// True when x lies in the closed convex polygon.
 bool contains(const ConvexPolygon& polygon, Vec2 x);
+/// True when x lies in the convex polygon grown by `slack` (a distance) beyond its edges' lines.
+bool contains(const ConvexPolygon& polygon, Vec2 x, double slack);
 
 /// The inverse of the bilinear map P(s,t) = (1-s)(1-t) q0 + s(1-t) q1 + s t q2 + (1-s) t q3 of
 /// a convex quadrilateral: the (s,t) with P(s,t) = q, exact up to rounding (closed form, then

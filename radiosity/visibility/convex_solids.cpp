@@ -162,12 +162,12 @@ std::optional<ConvexSolid> make_solid(const std::vector<Polygon>& polygons,
     std::vector<std::vector<const DirectedEdge*>> loops;
     for (const DirectedEdge& e : outline) {
         const int root = find_root(loop_parent, node_of(e.a));
-        const auto it = std::find(roots.begin(), roots.end(), root);
-        if (it == roots.end()) {
+        const size_t loop = size_t(std::find(roots.begin(), roots.end(), root) - roots.begin());
+        if (loop == roots.size()) {
             roots.push_back(root);
             loops.emplace_back();
         }
-        loops[size_t(std::find(roots.begin(), roots.end(), root) - roots.begin())].push_back(&e);
+        loops[loop].push_back(&e);
     }
     if (loops.size() > size_t(max_solid_openings)) return std::nullopt;
     for (const std::vector<const DirectedEdge*>& loop : loops) {

@@ -247,6 +247,26 @@ ConvexPolygon project_occluder(const ShooterPlane& plane, Vec3 p, double h_p,
     return clip_to_shooter(plane, shadow);
 }
 
+/// The central projections from p (at height h_p above the shooter's plane) of the part of a
+/// polytope between the plane and p: its corners in the slab (heights h), then its edges'
+/// crossings of the slab's two planes, in order (as solid_shadow and shadow_covered cut them).
+std::vector<Vec2> project_slab_part(const ShooterPlane& plane, Vec3 p, double h_p,
+                                    const std::vector<Vec3>& points, const std::vector<double>& h,
+                                    const std::vector<std::array<int, 2>>& edges) {
+    const double h_max = slab_top(h_p);
+    std::vector<Vec3> slab;
+    slab.reserve(h.size() + 8);  // the corners in the slab and a few edges' crossings
+    for (size_t k = 0; k < h.size(); ++k)
+        if (h[k] >= 0 && h[k] <= h_max) slab.push_back(points[k]);
+    for (const std::array<int, 2>& e : edges)
+        push_slab_crossings(points[size_t(e[0])], points[size_t(e[1])], h[size_t(e[0])],
+                            h[size_t(e[1])], h_max, slab);
+    std::vector<Vec2> projected;
+    projected.reserve(slab.size());
+    for (const Vec3& x : slab) projected.push_back(project_from(plane, p, h_p, x));
+    return projected;
+}
+
 /// Points and edges whose convex hull holds an occluder (a polygon's corners and sides, a box's
 /// corners and edges).
 struct Outline {
@@ -275,42 +295,21 @@ struct Outline {
 /// DESIGN: inside within 1e-9 of the shooter's size, as the shadows' own edges are rounded.
 bool shadow_covered(const ShooterPlane& plane, Vec3 p, double h_p, const Outline& outline,
                     const std::vector<ConvexPolygon>& shadows) {
-    const double h_max = slab_top(h_p);
     std::vector<double> h(outline.points.size());
-    std::vector<Vec3> slab;
-    for (size_t k = 0; k < h.size(); ++k) {
+    for (size_t k = 0; k < h.size(); ++k)
         h[k] = dot(plane.normal, outline.points[k] - plane.origin);
-        if (h[k] >= 0 && h[k] <= h_max) slab.push_back(outline.points[k]);
-    }
-    for (const std::array<int, 2>& e : outline.edges)
-        push_slab_crossings(outline.points[size_t(e[0])], outline.points[size_t(e[1])],
-                            h[size_t(e[0])], h[size_t(e[1])], h_max, slab);
-    if (slab.empty()) return true;  // wholly outside the slab: it meets no segment
-    std::vector<Vec2> projected;
-    for (const Vec3& x : slab) projected.push_back(project_from(plane, p, h_p, x));
-    ConvexPolygon hull = convex_hull(projected);
-    if (hull.size() >= 3) {
-        hull = intersect(hull, plane.outline);
-        if (hull.empty()) return true;  // it hides none of the shooter
-    } else {
-        return false;  // (a point or a segment: not worth deciding)
-    }
+    std::vector<Vec2> projected =
+        project_slab_part(plane, p, h_p, outline.points, h, outline.edges);
+    if (projected.empty()) return true;  // wholly outside the slab: it meets no segment
+    ConvexPolygon hull = convex_hull(std::move(projected));
+    if (hull.size() < 3) return false;  // (a point or a segment: not worth deciding)
+    hull = intersect(hull, plane.outline);
+    if (hull.empty()) return true;  // it hides none of the shooter
     const double slack = 1e-9 * plane.size;
-    for (const ConvexPolygon& shadow : shadows) {
-        const size_t n = shadow.size();
-        bool inside = n >= 3;
-        for (size_t e = 0; e < n && inside; ++e) {
-            const Vec2 a = shadow[e], b = shadow[(e + 1) % n];
-            const Vec2 d = b - a;
-            const double len = std::sqrt(dot(d, d));
-            for (const Vec2& q : hull)
-                if (cross(d, q - a) < -slack * len) {
-                    inside = false;
-                    break;
-                }
-        }
-        if (inside) return true;
-    }
+    for (const ConvexPolygon& shadow : shadows)
+        if (std::all_of(hull.begin(), hull.end(),
+                        [&](Vec2 q) { return contains(shadow, q, slack); }))
+            return true;
     return false;
 }
 
@@ -372,17 +371,8 @@ std::optional<ConvexPolygon> solid_shadow(const ShooterPlane& plane, Vec3 p, dou
                 return std::nullopt;
             }
         }
-    std::vector<Vec3> slab;
-    slab.reserve(h.size() + 8);  // the corners in the slab and a few edges' crossings
-    for (size_t k = 0; k < h.size(); ++k)
-        if (h[k] >= 0 && h[k] <= h_max) slab.push_back(solid.vertices[k]);
-    for (const std::array<int, 2>& e : solid.edges)
-        push_slab_crossings(solid.vertices[size_t(e[0])], solid.vertices[size_t(e[1])],
-                            h[size_t(e[0])], h[size_t(e[1])], h_max, slab);
-    if (slab.size() < 3) return ConvexPolygon{};
-    std::vector<Vec2> projected;
-    projected.reserve(slab.size());
-    for (const Vec3& x : slab) projected.push_back(project_from(plane, p, h_p, x));
+    std::vector<Vec2> projected = project_slab_part(plane, p, h_p, solid.vertices, h, solid.edges);
+    if (projected.size() < 3) return ConvexPolygon{};
     const ConvexPolygon hull = convex_hull(std::move(projected));
     if (hull.empty()) return hull;  // seen edge-on: it hides nothing
     return clip_to_shooter(plane, hull);
