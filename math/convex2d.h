@@ -76,8 +76,8 @@ ConvexPolygon convex_hull(std::vector<Vec2> points);
 /// area(b) - area(a and b) within rel_tolerance of the hull's area), else an empty polygon.
 ConvexPolygon convex_union(const ConvexPolygon& a, const ConvexPolygon& b, double rel_tolerance = 1e-9);
 
-/// How a convex polygon lies relative to another: disjoint (at most touching), inside it
-/// (within `slack` of its edges), or overlapping.
+/// How a convex polygon lies relative to another: disjoint (at most touching), inside it (every
+/// vertex on or inside every edge line, no slack), or overlapping.
 enum class Overlap { disjoint, inside, partial };
 /// Where `a` lies relative to `b` (separating-axis test over both polygons' edges).
 Overlap classify(const ConvexPolygon& a, const ConvexPolygon& b);
