@@ -46,7 +46,8 @@ TEST_CASE("progress: off a terminal, a line every interval, the end of a stage a
         progress.stage("building the octree of 9 surfaces");  // no event inside it
         sleep_for(0.5);
         progress.stage("hidden regions");
-        progress.update("1/4 surfaces", 0.25);
+        sleep_for(0.2);
+        progress.update("1/4 surfaces", 0.25);  // about 0.6 s left
         sleep_for(0.3);
         progress.update("4/4 surfaces", 1.0);
         progress.stage("");  // idle: nothing more is shown
@@ -61,6 +62,23 @@ TEST_CASE("progress: off a terminal, a line every interval, the end of a stage a
     // Idle at the end: the last line is the stage's end.
     CHECK(log.rfind("4/4 surfaces") > log.rfind("1/4 surfaces"));
     CHECK(log.substr(log.rfind('\n', log.size() - 2) + 1).find("4/4") != std::string::npos);
+}
+
+TEST_CASE("progress: an estimate counts down between events and is dropped once run out",
+          "[progress]") {
+    const std::string log = stderr_of([] {
+        mbr::ProgressReporter progress(true, 0.2);
+        progress.stage("shot 2/3");
+        progress.update("0/5 transfers", 0.5, 1.0);  // one second left, then no event
+        sleep_for(2.2);
+        progress.stage("");
+    });
+    CAPTURE(log);
+    // The lines before the second ends carry the estimate; the last ones, after it, do not.
+    CHECK_THAT(log, Contains("0/5 transfers, 0.2 s, about 1 s left"));
+    const std::string last = log.substr(log.rfind('\n', log.size() - 2) + 1);
+    CHECK_THAT(last, Contains("0/5 transfers, 2."));
+    CHECK(last.find("left") == std::string::npos);
 }
 
 TEST_CASE("progress: a run shorter than the interval, or turned off, says nothing", "[progress]") {

@@ -58,6 +58,7 @@ void ProgressReporter::update(const std::string& text, double fraction, double s
     detail_ = text;
     fraction_ = fraction;
     seconds_left_ = seconds_left;
+    estimated_at_ = now_seconds();
     // The end of a stage that the log has shown is said at once.
     if (!terminal_ && fraction >= 1 && now_seconds() - start_ >= interval_)
         show_locked(line_locked(now_seconds()));
@@ -95,9 +96,12 @@ std::string ProgressReporter::line_locked(double now) const {
     line += stage_;
     if (!detail_.empty()) line += ": " + detail_;
     char tail[96];
-    if (seconds_left_ >= 0)
+    // The estimate less the time since it was given; once that has run out the estimate was
+    // wrong, and the line says only the time so far until the next event gives a new one.
+    const double left = seconds_left_ - (now - estimated_at_);
+    if (seconds_left_ >= 0 && left > 0)
         std::snprintf(tail, sizeof tail, ", %.1f s, about %s left", now - stage_start_,
-                      format_duration(seconds_left_).c_str());
+                      format_duration(left).c_str());
     else
         std::snprintf(tail, sizeof tail, ", %.1f s", now - stage_start_);
     return line + tail;

@@ -38,7 +38,9 @@ public:
     /// is printed at once, so that the log says the stage ended.
     void update(const std::string& text, double fraction = -1);
     /// Like update, with the estimate of the time left given by the caller (seconds, < 0:
-    /// none), for stages whose fraction is not linear in time (the shots).
+    /// none), for stages whose fraction is not linear in time (the shots). Between events the
+    /// line counts the estimate down, and drops it once it has run out (a shot whose first
+    /// transfers are slow is not "about 1 s left" for minutes).
     void update(const std::string& text, double fraction, double seconds_left);
 
     /// Seconds between lines off a terminal, by default.
@@ -58,6 +60,7 @@ private:
     bool stop_ = false;
     std::string stage_, detail_;
     double fraction_ = -1, seconds_left_ = -1;
+    double estimated_at_ = 0;  // when seconds_left_ was given: the line counts down from it
     double stage_start_ = 0, start_ = 0;
     double next_line_ = 0;     // off a terminal: when the next line is due (run time)
     bool drawn_ = false;       // a line is on the terminal, to be cleared at the end
