@@ -179,14 +179,14 @@ TEST_CASE("options: solver_options turns each choice into the solver's own", "[o
     s.shadows = ShadowSetting::Paper;
     s.extrapolation = ExtrapolationSetting::Higher;
     s.unify = UnifySetting::Paper;
-    s.contact_oracle = OracleSetting::Interpolation;
+    s.contact_oracle = OracleSetting::Means;
     s.oracle = OracleSetting::Means;
     s.shadow_rays = 9;
     const SolverOptions o = solver_options(s);
     CHECK(o.receiver.shadows.method == ShadowMethod::Fractions);
     CHECK(o.receiver.extrapolation == Extrapolation::Quadratic);
     CHECK_FALSE(o.receiver.unify_by_projection);
-    CHECK(o.receiver.contact_oracle_test == OracleTest::Interpolation);
+    CHECK(o.receiver.contact_oracle_test == OracleTest::Means);
     CHECK(o.receiver.oracle_test == OracleTest::Means);
     CHECK(o.receiver.shadows.rays_per_patch == 9);
     s.shadows = ShadowSetting::None;
@@ -196,7 +196,7 @@ TEST_CASE("options: solver_options turns each choice into the solver's own", "[o
     CHECK(d.receiver.unify_by_projection);
     CHECK(d.receiver.extrapolation == Extrapolation::Linear);
     CHECK(d.receiver.oracle_test == OracleTest::Hybrid);
-    CHECK(d.receiver.contact_oracle_test == OracleTest::Means);
+    CHECK(d.receiver.contact_oracle_test == OracleTest::Interpolation);
     CHECK(d.receiver.shadows.kernel_weighted);  // `set fraction_rays kernel`, the default
     s.fraction_rays = FractionRaysSetting::Area;
     CHECK_FALSE(solver_options(s).receiver.shadows.kernel_weighted);

@@ -566,7 +566,7 @@ TEST_CASE("scene_io: every statement of the format", "[scene_io]") {
         "set order 3\nset min_depth 2\nset max_depth 5\nset oracle_tolerance 1e-4\n"
         "set truncation_eps 1e-7\nset rhombus_radius 20\nset extrapolation higher\n"
         "set shadow_rays 8\nset max_shots 10\nset convergence 0.01\nset self_transfer true\n"
-        "set tessellation 8\nset contact_oracle interpolation\n");
+        "set tessellation 8\nset contact_oracle means\n");
     CHECK(s.materials.size() == 4 + 4);
     CHECK(s.surfaces.size() == 3 + 12 + 6 + 16);
     CHECK(s.emitters().size() == 12 + 2 + 1);  // the img boxes, the lamp spheres, the OBJ light
@@ -594,15 +594,15 @@ TEST_CASE("scene_io: every statement of the format", "[scene_io]") {
     CHECK(o.convergence == 0.01);
     CHECK(o.self_transfer);
     CHECK(o.tessellation == 8);
-    CHECK(o.contact_oracle == OracleSetting::Interpolation);
-    CHECK(solver_options(o).receiver.contact_oracle_test == OracleTest::Interpolation);
+    CHECK(o.contact_oracle == OracleSetting::Means);
+    CHECK(solver_options(o).receiver.contact_oracle_test == OracleTest::Means);
     // Defaults when nothing is set.
     Scene d = parse_text(white + square);
     CHECK(d.settings.order == 4);
     CHECK(d.settings.oracle == OracleSetting::Hybrid);
-    CHECK(d.settings.contact_oracle == OracleSetting::Means);
+    CHECK(d.settings.contact_oracle == OracleSetting::Interpolation);
     CHECK(solver_options(d.settings).receiver.oracle_test == OracleTest::Hybrid);
-    CHECK(solver_options(d.settings).receiver.contact_oracle_test == OracleTest::Means);
+    CHECK(solver_options(d.settings).receiver.contact_oracle_test == OracleTest::Interpolation);
     CHECK(d.settings.extrapolation == ExtrapolationSetting::Linear);
     CHECK(!d.has_camera);
 }

@@ -20,7 +20,7 @@
 // unshot power of a face below 1e-6 of the emitted; at most 2000 shots) and a tighter
 // tolerance than the solver's default: 5e-4 of the radiosity scale (the default is 2e-3),
 // with the Interpolation test of the oracle in cells that touch the shooter (`set
-// contact_oracle interpolation`; the solver's default is the paper's test). A cube is all contact:
+// contact_oracle interpolation`, the solver's default too). A cube is all contact:
 // every face meets four others, and next to a shared edge and most of all at a corner B changes on
 // the scale of the distance to the edge. There the two means of the paper's oracle agree long
 // before the spline follows B, and a tighter tolerance does not help it: the largest error of
@@ -28,7 +28,7 @@
 // interpolation test gives 1.61 %, 1.26 % and 0.41 % (docs/method.md). The solver's other
 // defaults hold (order 4, depths 1..6, exact shadows, hidden regions, the ambient correction).
 // Every solver option of the other scene programs can override them (--tolerance 2e-3
-// --contact-oracle means gives the solver's defaults). The text output shows each case with and
+// gives the solver's defaults). The text output shows each case with and
 // without the ambient correction (the constant radiosity per face that sends on the power still
 // unshot at the end, SolverOptions:: ambient): both come from the same shots. --csv prints the case
 // as configured (--ambient, on by default) under the header

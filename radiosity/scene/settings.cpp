@@ -181,8 +181,8 @@ std::vector<OptionSpec> make_option_table() {
         choice_option("contact_oracle", &S::contact_oracle, {"hybrid", "interpolation", "means"},
                       "the oracle's test in receiver cells that touch a planar shooter (come "
                       "within a quarter of their size of it; see oracle): interpolation follows "
-                      "B at shared edges and corners, at more cost; the paper's means cost "
-                      "least and do best on the Cornell box (docs/method.md)"),
+                      "B at shared edges and corners (a block's foot on a floor); the paper's "
+                      "means cost least (docs/method.md)"),
         choice_option("fraction_rays", &S::fraction_rays, {"kernel", "area"},
                       "paper shadows: how a fraction (28) counts its rays to a shooter patch: "
                       "each weighted by the shooter's radiosity times the kernel (3) at its end "

@@ -82,7 +82,7 @@ struct SolverSettings {
     int contact_depth = 2;      // receiver cells touching a planar shooter split to at
                                 //   least this level (0: off)
     OracleSetting oracle = OracleSetting::Hybrid;
-    OracleSetting contact_oracle = OracleSetting::Means;
+    OracleSetting contact_oracle = OracleSetting::Interpolation;
     double weak_transfer = 0.3;  // a transfer whose root samples are below this many
                                  //   tolerances takes the level-0 field through them (0: off)
     TextureFieldSetting texture_field = TextureFieldSetting::Irradiance;
