@@ -179,15 +179,15 @@ TEST_CASE("options: solver_options turns each choice into the solver's own", "[o
     s.shadows = ShadowSetting::Paper;
     s.extrapolation = ExtrapolationSetting::Higher;
     s.unify = UnifySetting::Paper;
-    s.contact_oracle = OracleSetting::Means;
-    s.oracle = OracleSetting::Means;
+    s.contact_oracle = OracleSetting::Means;  // neither default, and not each other
+    s.oracle = OracleSetting::Interpolation;
     s.shadow_rays = 9;
     const SolverOptions o = solver_options(s);
     CHECK(o.receiver.shadows.method == ShadowMethod::Fractions);
     CHECK(o.receiver.extrapolation == Extrapolation::Quadratic);
     CHECK_FALSE(o.receiver.unify_by_projection);
     CHECK(o.receiver.contact_oracle_test == OracleTest::Means);
-    CHECK(o.receiver.oracle_test == OracleTest::Means);
+    CHECK(o.receiver.oracle_test == OracleTest::Interpolation);
     CHECK(o.receiver.shadows.rays_per_patch == 9);
     s.shadows = ShadowSetting::None;
     CHECK(solver_options(s).receiver.shadows.method == ShadowMethod::None);
