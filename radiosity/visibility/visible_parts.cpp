@@ -529,6 +529,13 @@ BlockedView blocked_view(const ShooterPlane& plane, Vec3 p, Vec3 n_p,
         auto add_shadow = [&slots](size_t slot, ConvexPolygon shadow) {
             if (!shadow.empty()) slots[slot].push_back(std::move(shadow));
         };
+        // Every shadow in the slots so far (a solid refused for an opening has none yet).
+        auto shadows_so_far = [&slots]() {
+            std::vector<ConvexPolygon> all;
+            for (const std::vector<ConvexPolygon>& slot : slots)
+                all.insert(all.end(), slot.begin(), slot.end());
+            return all;
+        };
         auto add_faces = [&](size_t slot, const ConvexSolid& solid) {
             for (int id : solid.polygons)
                 if (std::binary_search(occluders->begin(), occluders->end(), id))
@@ -583,9 +590,7 @@ BlockedView blocked_view(const ShooterPlane& plane, Vec3 p, Vec3 n_p,
             singles.push_back(k);
         }
         if (n_casters + static_cast<int>(singles.size()) > exact_limit) {
-            std::vector<ConvexPolygon> cover;  // the solids' and sheets' shadows so far
-            for (const std::vector<ConvexPolygon>& slot : slots)
-                cover.insert(cover.end(), slot.begin(), slot.end());
+            const std::vector<ConvexPolygon> cover = shadows_so_far();  // solids' and sheets'
             std::vector<size_t> kept;
             for (size_t a = 0; a < singles.size();) {
                 // The run of loose polygons of one surface (the list is by polygon, and a surface's
@@ -619,11 +624,7 @@ BlockedView blocked_view(const ShooterPlane& plane, Vec3 p, Vec3 n_p,
         // p sees is blocked by another caster (its shadow holds the opening's: a table leg's top
         // under the table), else their faces.
         if (!seen_openings.empty()) {
-            std::vector<ConvexPolygon> cover;
-            for (size_t slot = 0; slot < slots.size(); ++slot)
-                if (std::find(seen_openings.begin(), seen_openings.end(), slot) ==
-                    seen_openings.end())
-                    cover.insert(cover.end(), slots[slot].begin(), slots[slot].end());
+            const std::vector<ConvexPolygon> cover = shadows_so_far();
             for (size_t k : seen_openings) {
                 const ConvexSolid& solid = context->solids->solids[size_t((*solid_ids)[k])];
                 bool covered = true;
