@@ -568,6 +568,83 @@ TEST_CASE("shadow: occluders_toward with a limit gives the whole list or more th
     CHECK(n_whole > 20);
 }
 
+TEST_CASE(
+    "shadow: occluders_toward leaves out a polygon beside the pyramid that no one side "
+    "separates, scanned or walked",
+    "[shadow][visible_parts]") {
+    // The pyramid from p = (0.5, 0.5, 0) to the unit shooter at z = 1 crosses z = 0.5 in the
+    // square [0.25, 0.75]^2. Triangle 2 lies at that height across the square's corner
+    // (0.75, 0.75): one vertex has x < 0.75 and another y < 0.75, so no side of the pyramid has
+    // all three beyond it, yet the triangle holds only points with x + y >= 1.6 (the square's:
+    // at most 1.5) and casts no shadow at p. Triangle 3 holds (0.7, 0.7). Both must be
+    // judged alike whether the pair's candidates are few enough to scan (the triangles alone)
+    // or so many that the octree is walked (2,100 small triangles more, near the receiver's
+    // corner, far from p's pyramid).
+    const Surface shooter = Surface::planar_quad({0, 0, 1}, {0, 1, 1}, {1, 1, 1}, {1, 0, 1});
+    const Surface receiver = Surface::planar_quad({0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0});
+    const ShooterPlane plane = make_shooter_plane(shooter);
+    const Vec3 p{0.5, 0.5, 0};
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> u(0, 1);
+    for (int extra : {0, 2100}) {
+        std::vector<Polygon> polygons;
+        polygons.push_back(make_polygon(quad_polygon(shooter), 0));
+        polygons.push_back(make_polygon(quad_polygon(receiver), 1));
+        polygons.push_back(make_polygon({{0.7, 0.9, 0.5}, {0.9, 0.7, 0.5}, {0.95, 0.95, 0.5}}, 2));
+        polygons.push_back(make_polygon({{0.7, 0.7, 0.5}, {0.9, 0.7, 0.5}, {0.7, 0.9, 0.5}}, 3));
+        for (int i = 0; i < extra; ++i)
+            polygons.push_back(make_polygon(
+                random_triangle(
+                    rng, {0.9 + 0.08 * u(rng), 0.9 + 0.08 * u(rng), 0.02 + 0.1 * u(rng)}, 0.01),
+                4 + i));
+        const Octree octree(polygons, OctreeOptions{6, 4});
+        const OcclusionContext ctx = make_occlusion_context(octree, shooter, 0, receiver, 1, 0);
+        CAPTURE(extra, ctx.candidates.size());
+        REQUIRE((ctx.candidates.size() > max_scanned_candidates) == (extra > 0));
+        const std::vector<int> toward = occluders_toward(ctx, plane, p);
+        CHECK(toward == std::vector<int>{3});
+    }
+}
+
+TEST_CASE("shadow: occluders_toward's scan and octree walk list the same occluders",
+          "[shadow][visible_parts]") {
+    // 2,100 random triangles between a unit shooter and a unit receiver: more candidates than
+    // max_scanned_candidates, so the octree is walked. The same pair with its first 2,000
+    // candidates only is scanned; at points of the receiver the scan must list exactly the walk's
+    // occluders among those 2,000. And every triangle that a segment from the point to a
+    // random point of the shooter meets is listed.
+    std::mt19937 rng(91);
+    std::uniform_real_distribution<double> u(0, 1);
+    const TriangleCloud cloud = triangle_cloud(rng, 2100);
+    const Octree octree(cloud.polygons, OctreeOptions{6, 4});
+    const OcclusionContext ctx =
+        make_occlusion_context(octree, cloud.shooter, 0, cloud.receiver, 1, 0);
+    REQUIRE(ctx.candidates.size() > max_scanned_candidates);
+    OcclusionContext fewer = ctx;
+    fewer.candidates.resize(2000);
+    const ShooterPlane plane = make_shooter_plane(cloud.shooter);
+    size_t listed = 0;
+    for (int k = 0; k < 20; ++k) {
+        const Vec3 p{u(rng), u(rng), 0};
+        const std::vector<int> walked = occluders_toward(ctx, plane, p);
+        const std::vector<int> scanned = occluders_toward(fewer, plane, p);
+        std::vector<int> walked_among;
+        for (int id : walked)
+            if (std::binary_search(fewer.candidates.begin(), fewer.candidates.end(), id))
+                walked_among.push_back(id);
+        CAPTURE(k, walked.size(), scanned.size());
+        CHECK(scanned == walked_among);
+        listed += walked.size();
+        for (int r = 0; r < 200; ++r) {
+            const Vec3 x = cloud.shooter.point(u(rng), u(rng));
+            for (int id : ctx.candidates)
+                if (octree.polygons()[size_t(id)].intersect_segment(Ray{p, x - p, 0, 1}))
+                    CHECK(std::binary_search(walked.begin(), walked.end(), id));
+        }
+    }
+    CHECK(listed > 20 * 50);  // the pyramids hold many triangles
+}
+
 TEST_CASE("shadow: ray visibility on a planar shooter keeps every occluder of a cell's shaft",
           "[shadow][visible_parts]") {
     // A unit shooter at z = 1 facing down over a unit receiver at z = 0, 150 random triangles

@@ -82,12 +82,18 @@ struct BlockedView {
     std::vector<int> occluders;          // then: the occluders that meet p's pyramid
     bool trivial() const { return !behind_all && !horizon_cuts && shadows.empty() && !use_rays; }
 };
+/// Up to this many candidates of a pair, occluders_toward tests each of them; beyond, it walks
+/// the octree.
+constexpr size_t max_scanned_candidates = 2048;
+
 /// The context's candidates that meet the pyramid from p to a planar shooter (the convex hull
-/// of p and the shooter's outline), increasing: the only polygons that can block a segment
-/// from p to a point of the shooter. The octree finds them when the candidates are many.
-/// With a `limit`, the search stops as soon as more than `limit` distinct occluders are found
-/// and returns those (more than `limit`, not all): enough for a caller that tests rays against
-/// the list when it is short and against the octree otherwise.
+/// of p and the shooter's outline, within 1e-9 of the coordinates' size), increasing: the only
+/// polygons that can block a segment from p to a point of the shooter. Each candidate is tested
+/// when they are at most max_scanned_candidates; else the octree's walk finds them among the
+/// polygons of the leaves the pyramid meets. With a `limit`, the walk stops as soon as more than
+/// `limit` distinct occluders are found and returns those (more than `limit`, not all): enough
+/// for a caller that tests rays against the list when it is short and against the octree
+/// otherwise.
 std::vector<int> occluders_toward(const OcclusionContext& context, const ShooterPlane& plane,
                                   Vec3 p, size_t limit = SIZE_MAX);
 
