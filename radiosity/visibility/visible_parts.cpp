@@ -145,7 +145,10 @@ std::vector<int> occluders_toward(const OcclusionContext& context, const Shooter
     // on one thread; docs/method.md, "The occluders toward a point").
     if (context.candidates.size() <= max_scanned_candidates) {
         for (int id : context.candidates)
-            if (meets(id)) out.push_back(id);
+            if (meets(id)) {
+                out.push_back(id);
+                if (out.size() > limit) break;  // more than `limit`: enough (see the header)
+            }
         return out;
     }
     // The octree's leaves one at a time (a polygon listed by several leaves comes several

@@ -90,9 +90,9 @@ constexpr size_t max_scanned_candidates = 2048;
 /// of p and the shooter's outline, within 1e-9 of the coordinates' size), increasing: the only
 /// polygons that can block a segment from p to a point of the shooter. Each candidate is tested
 /// when they are at most max_scanned_candidates; else the octree's walk finds them among the
-/// polygons of the leaves the pyramid meets. With a `limit`, the walk stops as soon as more than
-/// `limit` distinct occluders are found and returns those (more than `limit`, not all): enough
-/// for a caller that tests rays against the list when it is short and against the octree
+/// polygons of the leaves the pyramid meets. With a `limit`, the search stops as soon as more
+/// than `limit` distinct occluders are found and returns those (more than `limit`, not all):
+/// enough for a caller that tests rays against the list when it is short and against the octree
 /// otherwise.
 std::vector<int> occluders_toward(const OcclusionContext& context, const ShooterPlane& plane,
                                   Vec3 p, size_t limit = SIZE_MAX);
