@@ -130,9 +130,10 @@ FractionSums shooter_fraction(const ReceiverState& state, const OcclusionContext
     // meet its pyramid to a planar shooter; when there are none the fraction is 1 without a ray
     // (what the rays would give, to the bit) and without the partition's kernel evaluations.
     std::vector<int> toward;
-    std::vector<Box3> near_boxes;  // the pair's surface boxes that meet p's pyramid
-    std::vector<Box3> grown_boxes;  // the same, grown_for_segments (OcclusionContext::segment_boxes)
-    bool many_boxes = false;       // more than max_near_boxes of them (the list stops there)
+    std::vector<Box3> near_boxes;  // the pair's surface boxes that meet p's pyramid, all of them
+    std::vector<Box3> grown_boxes;  // the first max_near_boxes of them, grown_for_segments
+                                    //   (OcclusionContext::segment_boxes)
+    bool many_boxes = false;        // more than max_near_boxes of them
     bool listed = false;           // toward lists every occluder that meets the pyramid
     const ShooterPlane* plane = integrator.shooter_plane();
     if (plane) {
@@ -141,14 +142,16 @@ FractionSums shooter_fraction(const ReceiverState& state, const OcclusionContext
         const Vec3 corners[4] = {shooter.point(0, 0), shooter.point(1, 0), shooter.point(1, 1),
                                  shooter.point(0, 1)};
         const Shaft pyramid(p.position, corners);
-        int near_count = 0;  // candidates in the boxes met
-        for (size_t k = 0; k < ctx.surface_boxes.size() && !many_boxes; ++k)
+        int near_count = 0;  // candidates in the first max_near_boxes + 1 boxes met
+        for (size_t k = 0; k < ctx.surface_boxes.size(); ++k)
             if (pyramid.meets(ctx.surface_boxes[k])) {
-                many_boxes = near_boxes.size() == max_near_boxes;
+                if (near_boxes.size() <= max_near_boxes) {
+                    near_count += ctx.surface_box_counts[k];
+                    grown_boxes.push_back(ctx.segment_boxes[k]);
+                }
                 near_boxes.push_back(ctx.surface_boxes[k]);
-                grown_boxes.push_back(ctx.segment_boxes[k]);
-                near_count += ctx.surface_box_counts[k];
             }
+        many_boxes = near_boxes.size() > max_near_boxes;
         if (near_boxes.empty()) return {{}, {}, true};
         // DESIGN: the octree's walk for the occluders that meet the pyramid (occluders_toward)
         // stops beyond max_listed_occluders; then the rays go through the octree, so the list
@@ -190,13 +193,16 @@ FractionSums shooter_fraction(const ReceiverState& state, const OcclusionContext
     // DESIGN: beyond the paper, a patch whose shaft from p meets no occluder's box is visible
     // without a ray (r_i = 1 exactly; the others keep their rays and weights, so (28) stays
     // unbiased). The boxes: the point's own occluders (toward) when it lists them all, else the
-    // pair's boxes (one per occluding surface) that its pyramid meets.
+    // pair's boxes (one per occluding surface) that its pyramid meets, all of them (a patch's
+    // shaft lies inside the pyramid: the others cannot meet it).
+    // DESIGN: before 2026-12-07 a point whose pyramid met more than max_near_boxes boxes tested
+    // every patch against all the pair's boxes (office2.mgf: hundreds a pair, 64 patches a point).
     std::vector<Box3> boxes;
     if (plane) {
         if (listed) {
             for (int id : toward) boxes.push_back(ctx.octree->polygons()[size_t(id)].bounds());
         } else {
-            boxes = many_boxes ? ctx.surface_boxes : near_boxes;
+            boxes = std::move(near_boxes);
         }
     }
     RecentBlockers recent;  // the point's last blockers, tested first (same answers)
