@@ -130,7 +130,7 @@ FractionSums shooter_fraction(const ReceiverState& state, const OcclusionContext
     // meet its pyramid to a planar shooter; when there are none the fraction is 1 without a ray
     // (what the rays would give, to the bit) and without the partition's kernel evaluations.
     std::vector<int> toward;
-    std::vector<Box3> near_boxes;  // the pair's surface boxes that meet p's pyramid, all of them
+    std::vector<Box3> near_boxes;   // the pair's surface boxes that meet p's pyramid, all of them
     std::vector<Box3> grown_boxes;  // the first max_near_boxes of them, grown_for_segments
                                     //   (OcclusionContext::segment_boxes)
     bool many_boxes = false;        // more than max_near_boxes of them
