@@ -153,10 +153,11 @@ FractionSums shooter_fraction(const ReceiverState& state, const OcclusionContext
             }
         many_boxes = near_boxes.size() > max_near_boxes;
         if (near_boxes.empty()) return {{}, {}, true};
-        // DESIGN: the octree's walk for the occluders that meet the pyramid (occluders_toward)
-        // stops beyond max_listed_occluders; then the rays go through the octree, so the list
-        // need not be complete. When the boxes met (at most max_near_boxes of them) hold more
-        // than walk_candidates (4 x max_listed_occluders) candidates the walk stops at the
+        // DESIGN: the search for the occluders that meet the pyramid (occluders_toward: a loop
+        // over the pair's candidates, or the octree's walk when they are many; "walk" below
+        // names both) stops beyond max_listed_occluders; then the rays go through the octree,
+        // so the list need not be complete. When the first max_near_boxes + 1 boxes met hold
+        // more than walk_candidates (4 x max_listed_occluders) candidates the walk stops at the
         // first occluder, only to tell a clear point (fraction 1 without a ray) from the
         // others: in the room (a few surfaces of hundreds of facets) 80 % of the full walks
         // overflowed, 13 % of its CPU. Many boxes of few polygons each (the classroom's chairs)

@@ -106,7 +106,7 @@ std::vector<int> occluders_toward(const OcclusionContext& context, const Shooter
     // Whether a polygon meets the pyramid: not when all its vertices lie beyond one side (the
     // quick test); else when something of it is left after clipping it to every side.
     // DESIGN: the clip, not the quick test alone, decides: a polygon beside the pyramid that no
-    // one side separates (across a corner of it) casts no shadow at p, but counted as a caster
+    // one side separates (beside one of its edges) casts no shadow at p, but counted as a caster
     // it could send p to rays (exact_limit) and kept its patches' rays. So the list is the same
     // whichever way it was found (the scan or the octree's walk below).
     std::vector<Vec3> part, next;
@@ -139,10 +139,10 @@ std::vector<int> occluders_toward(const OcclusionContext& context, const Shooter
     };
     std::vector<int> out;
     // DESIGN: up to max_scanned_candidates the pair's candidates are tested one by one: the
-    // octree's walk cost 11-17 us a point whatever the list (its nodes, a binary search of the
-    // candidates for each polygon a leaf lists, the polygons listed by several leaves), the scan
-    // 0.9 us at 32 candidates and 5.9 us at 1,024 (the classroom's first 4 shots, 608,000 points
-    // on one thread; docs/method.md, "The occluders toward a point").
+    // octree's walk cost 11.5-22 us a point whatever the list (its nodes, a binary search of
+    // the candidates for each polygon a leaf lists, the polygons listed by several leaves), the
+    // loop 0.9 us at 32 candidates and 5.9 us at 1,024 (the classroom's first 4 shots, 608,000
+    // points on one thread; docs/method.md, "The occluders toward a point, scanned").
     if (context.candidates.size() <= max_scanned_candidates) {
         for (int id : context.candidates)
             if (meets(id)) {
