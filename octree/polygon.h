@@ -61,6 +61,21 @@ struct Plane {
     double signed_distance(Vec3 p) const { return dot(normal, p) - offset; }
 };
 
+/// One step of Sutherland and Hodgman's clipping: appends to `out`, in order, the part of the
+/// polygon `in` (vertices in order) where value(v) >= 0, an edge whose ends lie on either side
+/// crossing at a + value(a) / (value(a) - value(b)) (b - a). value is an affine function of
+/// the point (a signed distance from a plane); a vertex where it is 0 is kept.
+template <class Value>
+void clip_polygon(const std::vector<Vec3>& in, Value value, std::vector<Vec3>& out) {
+    for (size_t i = 0; i < in.size(); ++i) {
+        const Vec3& a = in[i];
+        const Vec3& b = in[(i + 1) % in.size()];
+        const double da = value(a), db = value(b);
+        if (da >= 0) out.push_back(a);
+        if ((da >= 0) != (db >= 0)) out.push_back(a + (da / (da - db)) * (b - a));
+    }
+}
+
 /// Step 2 of the paper's ray-polygon test on bare planes: p, taken to lie in the polygon's plane,
 /// is on the inner side of each of the n bounding planes, by at most `slack` outside (closed).
 /// Written as !(d <= slack) so that a NaN counts as outside.

@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "math/simd.h"
+#include "octree/polygon.h"
 
 namespace mbr {
 
@@ -53,13 +54,8 @@ double point_polygon_form_factor(Vec3 p, Vec3 n_p, const std::vector<Vec3>& poly
     // Clip against p's tangent plane: keep the part with (v - p) . n_p >= 0.
     std::vector<Vec3> clipped;
     clipped.reserve(polygon.size() + 2);
-    for (size_t i = 0; i < polygon.size(); ++i) {
-        const Vec3& a = polygon[i];
-        const Vec3& b = polygon[(i + 1) % polygon.size()];
-        const double da = dot(a - p, n_p), db = dot(b - p, n_p);
-        if (da >= 0) clipped.push_back(a);
-        if ((da >= 0) != (db >= 0)) clipped.push_back(a + (da / (da - db)) * (b - a));
-    }
+    const auto in_front = [&](Vec3 v) { return dot(v - p, n_p); };
+    clip_polygon(polygon, in_front, clipped);
     if (clipped.size() < 3) return 0;
 
     // Lambert: F = (1 / 2 pi) sum_i gamma_i n_p . (R_i x R_{i+1}) / |R_i x R_{i+1}|.

@@ -124,14 +124,8 @@ std::vector<int> occluders_toward(const OcclusionContext& context, const Shooter
         part.assign(v.begin(), v.end());
         for (const Side& s : sides) {
             next.clear();
-            const size_t n = part.size();
-            for (size_t i = 0; i < n; ++i) {
-                const Vec3 a = part[i], b = part[(i + 1) % n];
-                const double da = dot(s.n, a) - s.d - tol, db = dot(s.n, b) - s.d - tol;
-                if (da <= 0) next.push_back(a);
-                if ((da < 0 && db > 0) || (da > 0 && db < 0))
-                    next.push_back(a + (da / (da - db)) * (b - a));
-            }
+            const auto inside = [&](Vec3 x) { return -(dot(s.n, x) - s.d - tol); };
+            clip_polygon(part, inside, next);
             part.swap(next);
             if (part.empty()) return false;
         }
